@@ -1,0 +1,74 @@
+#pragma once
+/// \file mesh_io.h
+/// Reading meshes from bytes or files (OBJ, OFF, PLY, STL, glTF/GLB), validating and repairing them
+/// into a 2-manifold, consistently oriented TriMesh; writing triangle and polygon meshes.
+///
+/// Reading never touches the disk except for the one file named by read_mesh_file(); a .gltf whose
+/// buffers point to external files is refused (MeshError). All functions are thread-safe.
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "core/errors.h"
+#include "core/mesh.h"
+
+namespace remesh {
+
+enum class Format { Obj, Off, Ply, Stl, Gltf, Glb, Xyz };
+
+/// "obj", "off", "ply", "stl", "gltf", "glb", "xyz".
+std::string_view format_name(Format f);
+/// Parses a name or extension ("obj", ".OBJ", "mesh.ply" -> Ply); nullopt if unknown.
+std::optional<Format> parse_format(std::string_view name_or_path);
+/// Sniffs the format from the first bytes; nullopt if nothing matches.
+std::optional<Format> detect_format(std::string_view bytes);
+
+/// One repair made while reading, e.g. {"polygons_triangulated", 12, "12 polygons fan-triangulated"}.
+struct Repair {
+  std::string kind;    ///< stable machine name
+  std::size_t count;   ///< how many elements it touched
+  std::string detail;  ///< one line for people, names where (indices, lines)
+};
+
+struct ReadOptions {
+  std::optional<Format> format;  ///< from the caller (extension, Content-Type); else sniffed
+  bool weld = false;             ///< weld duplicate vertices at the same position
+  std::size_t max_faces = 0;     ///< refuse (LimitError) meshes with more faces; 0 = no limit
+};
+
+struct LoadedMesh {
+  TriMesh mesh;                 ///< valid 2-manifold, consistently oriented, normals updated
+  Format format;                ///< the format it was read as
+  std::vector<Repair> repairs;  ///< every repair made, in order
+};
+
+/// Reads a mesh from memory. Throws MeshError naming the problem (and LimitError over max_faces).
+LoadedMesh read_mesh(std::string_view bytes, const ReadOptions& options = {});
+/// Reads a file; the format comes from the extension, else from the content.
+LoadedMesh read_mesh_file(const std::string& path, ReadOptions options = {});
+
+/// A neutral polygon list for writing: face f has indices[offsets[f] .. offsets[f+1]).
+struct PolygonSoup {
+  std::vector<Vec3> points;
+  std::vector<std::uint32_t> indices;
+  std::vector<std::uint32_t> offsets{0};
+};
+PolygonSoup to_soup(const TriMesh& mesh);
+PolygonSoup to_soup(const PolyMesh& mesh);
+
+/// Serialises to bytes. Polygons: OBJ/OFF/PLY keep them; STL fan-triangulates; GLB writes a
+/// triangle-fan primitive plus a LINES primitive of the true polygon edges; XYZ writes one atom
+/// ("C x y z") per point. Gltf is written as GLB. Throws std::invalid_argument for unsupported.
+std::string write_mesh(const PolygonSoup& soup, Format format);
+std::string write_mesh(const TriMesh& mesh, Format format);
+std::string write_mesh(const PolyMesh& mesh, Format format);
+/// Writes to a file, format from the extension. Throws MeshError if unknown, std::runtime_error on I/O.
+void write_mesh_file(const PolygonSoup& soup, const std::string& path);
+
+/// The MIME type served for a format (model/obj, model/gltf-binary, ...).
+std::string_view mime_type(Format f);
+
+}  // namespace remesh

@@ -1,0 +1,61 @@
+#pragma once
+/// \file equalize.h
+/// Iterative edge-length equalization (the thesis' Algorithm 1, as ../shared/ALGORITHM.md reads it):
+///
+///   for i = 1..n:
+///     if pr > 0 and i % pr == 0: reference = copy(mesh)
+///     m_i = min(2 * mean_edge_length(mesh), m)
+///     stellar operations on the priority list     (Algorithms 2, 3; eq. 3.1 repositioning)
+///     valence-improving flips                     (Algorithm 4)
+///     tangential k-ring low-pass filter           (Algorithm 5)
+///     projection onto the reference surface       (Algorithm 6)
+///     report the statistics row; stop if cancelled or converged
+
+#include <cstddef>
+#include <functional>
+#include <stop_token>
+
+#include "core/mesh.h"
+#include "remesh/params.h"
+
+namespace remesh {
+
+/// One row per iteration. Field names are stable: the API, CSV and JSON use them as they are.
+struct IterationStats {
+  int iteration = 0;
+  std::size_t vertices = 0, edges = 0;
+  double mean = 0;             ///< mean edge length
+  double deviation = 0;        ///< population standard deviation of edge lengths
+  double regular_percent = 0;  ///< % of interior vertices with valence 6
+  std::size_t small = 0;       ///< edges shorter than e_min
+  std::size_t big = 0;         ///< edges longer than e_max
+  double inside_fraction = 0;  ///< fraction of edges inside [e_min, e_max], 0..1
+  std::size_t splits = 0, collapses = 0, flips = 0;
+  double seconds = 0;                  ///< wall time of this iteration
+  double max_projection_distance = 0;  ///< largest distance a vertex moved in the projection
+};
+
+using OnIteration = std::function<void(const IterationStats&)>;
+
+enum class Outcome { Completed, Converged, Cancelled };
+
+struct Result {
+  Outcome outcome = Outcome::Completed;
+  int iterations_done = 0;
+  double seconds = 0;
+};
+
+/// Estimated face count of the output: area / (sqrt(3)/4 * m^2), m = (e_min + e_max) / 2.
+std::size_t estimate_output_faces(const TriMesh& mesh, const Params& params);
+
+/// Remeshes `mesh` in place. Preconditions: a valid 2-manifold, consistently oriented TriMesh (as
+/// read_mesh returns). Throws ParamsError if check(params) fails, LimitError if the estimated output
+/// exceeds params.max_output_faces. `on_iteration` runs on the calling thread after each iteration.
+/// A stop request is honoured between phases; the mesh is valid whenever this returns.
+Result equalize(TriMesh& mesh, const Params& params, const OnIteration& on_iteration = {},
+                std::stop_token stop = {});
+
+/// Statistics of a mesh against an interval, as a row with iteration 0 and zero counters.
+IterationStats measure(const TriMesh& mesh, double e_min, double e_max, unsigned threads = 0);
+
+}  // namespace remesh

@@ -1,0 +1,31 @@
+#pragma once
+/// \file reference_surface.h
+/// The reference surface of the projection step (Algorithm 6): a copy of a triangle mesh with a
+/// nanoflann kd-tree over its vertices. closest_point() looks at the triangles incident to the 30
+/// nearest reference vertices and returns the closest point on them; where candidates are nearly as
+/// close (thin parts, two sheets), the one whose normal agrees with `normal_hint` wins.
+/// Queries are const and safe from several threads.
+
+#include <cstddef>
+#include <memory>
+
+#include "core/mesh.h"
+
+namespace remesh {
+
+class ReferenceSurface {
+ public:
+  explicit ReferenceSurface(const TriMesh& mesh, std::size_t neighbours = 30);
+  ~ReferenceSurface();
+  ReferenceSurface(ReferenceSurface&&) noexcept;
+  ReferenceSurface& operator=(ReferenceSurface&&) noexcept;
+
+  /// Closest point on the reference surface to `p`. `normal_hint` may be zero (no preference).
+  Vec3 closest_point(const Vec3& p, const Vec3& normal_hint = Vec3(0, 0, 0)) const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace remesh
