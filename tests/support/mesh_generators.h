@@ -1,0 +1,37 @@
+#pragma once
+/// \file mesh_generators.h
+/// Small meshes built in code for the tests, and independent checks of mesh validity and topology
+/// (written here, not taken from the engine, so tests do not grade the engine with its own code).
+
+#include <cstddef>
+#include <string>
+
+#include "core/mesh.h"
+
+namespace remesh::test {
+
+/// Icosahedron subdivided `subdiv` times (20 * 4^subdiv faces), vertices on the sphere of `radius`.
+TriMesh make_icosphere(int subdiv, double radius = 1.0);
+/// Torus with nu x nv quads split into triangles; R = ring radius, r = tube radius.
+TriMesh make_torus(int nu, int nv, double R, double r);
+/// Flat open patch in z = 0, (nx x ny) quads of side `spacing`, alternating diagonals; one boundary loop.
+TriMesh make_open_grid(int nx, int ny, double spacing);
+/// Flat patch of the equilateral triangular lattice (side `spacing`), `rows` x `cols` vertices;
+/// every interior vertex has valence 6.
+TriMesh make_hex_lattice_patch(int rows, int cols, double spacing);
+/// Closed surface of a voxel plate with `holes` square holes through it: genus == holes.
+/// `cell` is the voxel size; each voxel face is split into 2 * sub * sub triangles.
+TriMesh make_plate_with_holes(int holes, double cell = 1.0, int sub = 2);
+/// Genus-2 closed surface (make_plate_with_holes(2, ...)).
+TriMesh make_double_torus(double cell = 1.0, int sub = 2);
+
+/// Empty if `mesh` is valid: no deleted elements left, every vertex manifold, every face a
+/// non-degenerate triangle (area > area_eps * mean area), no folded pair of adjacent triangles
+/// (normals with dot < -fold_cos). Otherwise a message naming the first problem.
+std::string check_mesh_valid(const TriMesh& mesh, double area_eps = 1e-10, double fold_cos = 0.95);
+
+std::size_t count_components(const TriMesh& mesh);
+std::size_t count_boundary_loops(const TriMesh& mesh);
+long euler_characteristic(const TriMesh& mesh);  ///< V - E + F (non-deleted, non-isolated vertices)
+
+}  // namespace remesh::test
