@@ -4,7 +4,9 @@
 #   scripts/setup.sh test   install what is missing (test tools too), build, run the whole test suite
 #   scripts/setup.sh deps [--test]   only install;   scripts/setup.sh build   only build
 # Idempotent: installs nothing that is already there, rebuilds only what changed.
-# Environment: REMESH_BUILD_DIR (default ./build), REMESH_JOBS (default: cores).
+# Environment: REMESH_BUILD_DIR (default ./build), REMESH_JOBS (default: cores),
+# REMESH_CMAKE_ARGS (extra options for the first configure).
+#   scripts/setup.sh deps --runtime   only what a built remeshd needs to run (Dockerfile)
 set -euo pipefail
 
 ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
@@ -15,6 +17,8 @@ JOBS=${REMESH_JOBS:-$(nproc)}
 BUILD_PACKAGES=(g++ cmake ninja-build pkg-config ca-certificates
   libcpp-httplib-dev nlohmann-json3-dev libopenmesh-dev libnanoflann-dev libtinygltf-dev catch2)
 TEST_PACKAGES=(chromium curl)
+# What the built remeshd needs at run time (the Dockerfile's final stage).
+RUNTIME_PACKAGES=(libopenmesh1 libtinygltf2d libcpp-httplib0.11 curl ca-certificates)
 
 log() { printf '[setup] %s\n' "$*" >&2; }
 
@@ -34,7 +38,9 @@ install_packages() {
   local missing
   missing=$(missing_packages "$@")
   # Node.js: any machine-wide node >= 18 with npm will do; else Debian's.
-  if ! command -v npm >/dev/null || ! command -v node >/dev/null; then missing="$missing nodejs npm"; fi
+  if [ -z "${NO_NODE:-}" ] && { ! command -v npm >/dev/null || ! command -v node >/dev/null; }; then
+    missing="$missing nodejs npm"
+  fi
   if [ -n "${missing// /}" ]; then
     log "installing:$(echo $missing | tr '\n' ' ')"
     as_root env DEBIAN_FRONTEND=noninteractive apt-get update -qq
@@ -56,14 +62,18 @@ web_packages() {
 }
 
 deps() {
-  if [ "${1:-}" = "--test" ]; then install_packages "${BUILD_PACKAGES[@]}" "${TEST_PACKAGES[@]}"
-  else install_packages "${BUILD_PACKAGES[@]}"; fi
+  case "${1:-}" in
+    --test) install_packages "${BUILD_PACKAGES[@]}" "${TEST_PACKAGES[@]}" ;;
+    --runtime) NO_NODE=1 install_packages "${RUNTIME_PACKAGES[@]}"; return 0 ;;
+    *) install_packages "${BUILD_PACKAGES[@]}" ;;
+  esac
   web_packages
 }
 
 build() {
   if [ ! -f "$BUILD/CMakeCache.txt" ]; then
-    cmake -S "$ROOT" -B "$BUILD" -G Ninja -DCMAKE_BUILD_TYPE=Release >/dev/null
+    # shellcheck disable=SC2086
+    cmake -S "$ROOT" -B "$BUILD" -G Ninja -DCMAKE_BUILD_TYPE=Release ${REMESH_CMAKE_ARGS:-} >/dev/null
   fi
   cmake --build "$BUILD" -j "$JOBS"
 }
