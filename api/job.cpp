@@ -1,0 +1,188 @@
+#include "job.h"
+
+#include <chrono>
+#include <cmath>
+#include <ctime>
+#include <random>
+#include <stdexcept>
+
+#include "json_codec.h"
+
+namespace remesh::api {
+
+using nlohmann::json;
+
+namespace {
+
+constexpr std::string_view kStates[] = {"queued",     "running",   "succeeded",
+                                        "failed",     "cancelling", "cancelled"};
+
+json time_or_null(const std::optional<double>& t) { return t ? json(iso8601(*t)) : json(nullptr); }
+
+/// Parses what iso8601() writes; throws std::runtime_error otherwise.
+double parse_iso8601(const std::string& s) {
+  std::tm tm{};
+  int ms = 0;
+  char z = 0;
+  if (std::sscanf(s.c_str(), "%4d-%2d-%2dT%2d:%2d:%2d.%3d%c", &tm.tm_year, &tm.tm_mon, &tm.tm_mday,
+                  &tm.tm_hour, &tm.tm_min, &tm.tm_sec, &ms, &z) != 8 || z != 'Z')
+    throw std::runtime_error("bad timestamp '" + s + "'");
+  tm.tm_year -= 1900;
+  tm.tm_mon -= 1;
+  return static_cast<double>(timegm(&tm)) + ms / 1000.0;
+}
+
+std::optional<double> opt_time(const json& j, const char* key) {
+  auto it = j.find(key);
+  if (it == j.end() || it->is_null()) return std::nullopt;
+  return parse_iso8601(it->get<std::string>());
+}
+
+json format_links(const std::string& base, const char* mesh, const std::vector<std::string>& formats) {
+  json links = json::object();
+  for (const std::string& f : formats) links[f] = base + "/result?mesh=" + mesh + "&format=" + f;
+  return links;
+}
+
+}  // namespace
+
+std::string_view state_name(JobState s) { return kStates[static_cast<int>(s)]; }
+
+std::optional<JobState> parse_state(std::string_view s) {
+  for (int i = 0; i < 6; ++i)
+    if (kStates[i] == s) return static_cast<JobState>(i);
+  return std::nullopt;
+}
+
+bool is_final(JobState s) {
+  return s == JobState::Succeeded || s == JobState::Failed || s == JobState::Cancelled;
+}
+
+double now_seconds() {
+  using namespace std::chrono;
+  return duration<double>(system_clock::now().time_since_epoch()).count();
+}
+
+std::string iso8601(double unix_seconds) {
+  double whole = std::floor(unix_seconds);
+  int ms = static_cast<int>(std::lround((unix_seconds - whole) * 1000));
+  if (ms >= 1000) {
+    whole += 1;
+    ms -= 1000;
+  }
+  std::time_t t = static_cast<std::time_t>(whole);
+  std::tm tm{};
+  gmtime_r(&t, &tm);
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%04d-%02d-%02dT%02d:%02d:%02d.%03dZ", tm.tm_year + 1900, tm.tm_mon + 1,
+                tm.tm_mday, tm.tm_hour, tm.tm_min, tm.tm_sec, ms);
+  return buf;
+}
+
+std::string_view outcome_name(Outcome o) {
+  switch (o) {
+    case Outcome::Converged: return "converged";
+    case Outcome::Completed: return "completed";
+    case Outcome::Cancelled: return "cancelled";
+  }
+  return "completed";
+}
+
+const std::vector<std::string>& remeshed_formats() {
+  static const std::vector<std::string> f = {"obj", "glb", "ply", "off", "stl"};
+  return f;
+}
+
+const std::vector<std::string>& dual_formats() {
+  static const std::vector<std::string> f = {"obj", "glb", "ply", "off", "xyz"};
+  return f;
+}
+
+json job_to_json(const JobRecord& job, std::string_view prefix, double now) {
+  const std::string base = std::string(prefix) + "/jobs/" + job.id;
+  double queued_end = job.started_at ? *job.started_at : (job.finished_at ? *job.finished_at : now);
+  double run_seconds = job.started_at ? (job.finished_at ? *job.finished_at : now) - *job.started_at : 0.0;
+  json params = job.params;
+  params["weld"] = job.weld;
+  json links = {{"self", base},
+                {"events", base + "/events"},
+                {"stats", base + "/stats"},
+                {"input", base + "/result?mesh=input&format=glb"}};
+  if (job.state == JobState::Succeeded)
+    links["results"] = {{"remeshed", format_links(base, "remeshed", remeshed_formats())},
+                        {"dual", format_links(base, "dual", dual_formats())}};
+  return json{
+      {"id", job.id},
+      {"state", state_name(job.state)},
+      {"created_at", iso8601(job.created_at)},
+      {"started_at", time_or_null(job.started_at)},
+      {"finished_at", time_or_null(job.finished_at)},
+      {"params", params},
+      {"input",
+       {{"filename", job.filename},
+        {"format", job.format},
+        {"bytes", job.bytes},
+        {"summary", job.summary},
+        {"repairs", job.repairs}}},
+      {"progress", {{"iteration", job.iteration}, {"iterations", job.params.iterations}}},
+      {"latest", job.latest ? json(*job.latest) : json(nullptr)},
+      {"outcome", job.outcome ? json(*job.outcome) : json(nullptr)},
+      {"error", job.error ? json(*job.error) : json(nullptr)},
+      {"timings",
+       {{"queued_seconds", std::max(0.0, queued_end - job.created_at)},
+        {"run_seconds", std::max(0.0, run_seconds)}}},
+      {"links", links},
+  };
+}
+
+JobRecord job_from_json(const json& j) {
+  try {
+    JobRecord job;
+    job.id = j.at("id").get<std::string>();
+    if (!is_valid_job_id(job.id)) throw std::runtime_error("bad id");
+    auto state = parse_state(j.at("state").get<std::string>());
+    if (!state) throw std::runtime_error("bad state");
+    job.state = *state;
+    job.created_at = parse_iso8601(j.at("created_at").get<std::string>());
+    job.started_at = opt_time(j, "started_at");
+    job.finished_at = opt_time(j, "finished_at");
+    ParsedParams parsed = params_from_json(j.at("params"));
+    if (!parsed.ok()) throw std::runtime_error("bad params: " + parsed.errors.front().field);
+    job.params = parsed.params;
+    job.weld = parsed.weld;
+    const json& in = j.at("input");
+    job.filename = in.at("filename").get<std::string>();
+    job.format = in.at("format").get<std::string>();
+    job.bytes = in.at("bytes").get<std::size_t>();
+    job.summary = in.at("summary");
+    job.repairs = in.at("repairs");
+    job.iteration = j.at("progress").at("iteration").get<int>();
+    if (!j.at("latest").is_null()) job.latest = j.at("latest").get<IterationStats>();
+    if (!j.at("outcome").is_null()) job.outcome = j.at("outcome").get<std::string>();
+    if (!j.at("error").is_null()) job.error = j.at("error").get<std::string>();
+    return job;
+  } catch (const json::exception& e) {
+    throw std::runtime_error(std::string("job document: ") + e.what());
+  }
+}
+
+std::string new_job_id() {
+  static thread_local std::random_device rd;
+  static constexpr char kHex[] = "0123456789abcdef";
+  std::string id;
+  id.reserve(32);
+  for (int i = 0; i < 4; ++i) {
+    std::uint32_t v = rd();
+    for (int k = 0; k < 8; ++k) id += kHex[(v >> (4 * k)) & 0xF];
+  }
+  return id;
+}
+
+bool is_valid_job_id(std::string_view id) {
+  if (id.size() != 32) return false;
+  for (char c : id)
+    if (!((c >= '0' && c <= '9') || (c >= 'a' && c <= 'f'))) return false;
+  return true;
+}
+
+}  // namespace remesh::api

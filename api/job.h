@@ -1,0 +1,72 @@
+#pragma once
+/// \file job.h
+/// The job model of the service: states, the record kept per job, and its JSON document (the
+/// public shape of GET /api/v1/jobs/{id}, also what remeshd persists as state.json).
+
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "remesh/equalize.h"
+#include "remesh/params.h"
+
+namespace remesh::api {
+
+/// queued -> running -> succeeded | failed | cancelled; queued/running -> cancelling -> cancelled.
+enum class JobState { Queued, Running, Succeeded, Failed, Cancelling, Cancelled };
+
+/// "queued", "running", "succeeded", "failed", "cancelling", "cancelled".
+std::string_view state_name(JobState s);
+/// Inverse of state_name; nullopt for anything else.
+std::optional<JobState> parse_state(std::string_view s);
+/// succeeded, failed, cancelled: nothing will change any more.
+bool is_final(JobState s);
+
+/// Seconds since the Unix epoch (UTC) with sub-second precision.
+double now_seconds();
+/// "2026-11-22T02:53:42.123Z" (milliseconds, UTC).
+std::string iso8601(double unix_seconds);
+
+/// Everything the service keeps about a job. Times are Unix seconds; nullopt = not yet.
+struct JobRecord {
+  std::string id;  ///< 32 lowercase hex characters
+  JobState state = JobState::Queued;
+  double created_at = 0;
+  std::optional<double> started_at, finished_at;
+  Params params;
+  bool weld = false;
+  std::string filename;        ///< as uploaded (display only, never a path)
+  std::string format;          ///< format name of the input ("obj", ...)
+  std::size_t bytes = 0;       ///< uploaded size
+  nlohmann::json summary;      ///< to_json(MeshSummary) of the validated input
+  nlohmann::json repairs = nlohmann::json::array();  ///< [{kind, count, detail}]
+  int iteration = 0;           ///< iterations done
+  std::optional<IterationStats> latest;
+  std::optional<std::string> outcome;  ///< "converged", "completed", "cancelled"
+  std::optional<std::string> error;
+};
+
+/// The public job document (see api/openapi.yaml, schema Job). `prefix` is the API root
+/// ("/api/v1"); `now` (Unix seconds) closes open timing intervals.
+nlohmann::json job_to_json(const JobRecord& job, std::string_view prefix, double now);
+
+/// Reads back a document written by job_to_json (links and timings are ignored). Throws
+/// std::runtime_error naming the bad field.
+JobRecord job_from_json(const nlohmann::json& j);
+
+/// "converged", "completed" or "cancelled".
+std::string_view outcome_name(Outcome o);
+
+/// Result kinds and the formats each can be downloaded in.
+const std::vector<std::string>& remeshed_formats();  ///< obj, glb, ply, off, stl
+const std::vector<std::string>& dual_formats();      ///< obj, glb, ply, off, xyz
+
+/// A fresh job id: 128 random bits from std::random_device as 32 lowercase hex characters.
+std::string new_job_id();
+/// True for exactly 32 characters of [0-9a-f] (so an id can name a directory safely).
+bool is_valid_job_id(std::string_view id);
+
+}  // namespace remesh::api

@@ -1,0 +1,86 @@
+#pragma once
+/// \file json_codec.h
+/// JSON (nlohmann) and CSV views of the engine's value types, and parameter parsing from JSON or a
+/// string map (query string, command line). Shared by remeshd and the `remesh` CLI.
+///
+/// Parameter names (API, CLI, JSON): emin, emax, iterations, rings, relax_every, flip_factor,
+/// run_all_iterations; `weld` is a read option carried alongside (ParsedParams::weld).
+
+#include <map>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "core/errors.h"
+#include "io/mesh_io.h"
+#include "io/summary.h"
+#include "remesh/equalize.h"
+#include "remesh/params.h"
+
+namespace remesh {
+
+// ---- engine values -> JSON (ADL hooks, so `nlohmann::json j = summary;` works) ----------------
+
+/// {vertices, faces, edges, components, boundary_loops, boundary_edges, euler,
+///  genus: [genus of each closed component], bbox {min:[x,y,z], max:[x,y,z], diagonal},
+///  edge_length {mean, min, max}, area}
+void to_json(nlohmann::json& j, const MeshSummary& s);
+/// {kind, count, detail}
+void to_json(nlohmann::json& j, const Repair& r);
+/// Every IterationStats field under its struct name, in struct order.
+void to_json(nlohmann::json& j, const IterationStats& s);
+/// Reads a row written by to_json; missing fields stay 0. Throws nlohmann::json::exception on
+/// wrong types.
+void from_json(const nlohmann::json& j, IterationStats& s);
+/// {emin, emax, iterations, rings, relax_every, flip_factor, run_all_iterations}
+void to_json(nlohmann::json& j, const Params& p);
+/// {field, message}
+void to_json(nlohmann::json& j, const FieldError& e);
+
+/// Summary JSON with the repairs added under "repairs" (the CLI's `--summary` output).
+nlohmann::json summary_json(const MeshSummary& s, const std::vector<Repair>& repairs);
+
+// ---- parameters ---------------------------------------------------------------------------------
+
+/// The result of parsing parameters: the values that parsed, and every bad field.
+struct ParsedParams {
+  Params params;                   ///< defaults where a field was absent or bad
+  bool weld = false;               ///< read option: weld duplicate vertices
+  std::vector<FieldError> errors;  ///< empty when every field parsed (range checks: check())
+  bool ok() const { return errors.empty(); }
+};
+
+/// Parameter names accepted by params_from_json / params_from_query, in documentation order.
+const std::vector<std::string>& param_names();
+
+/// Parses a JSON object. Reports type errors ("must be a number"), missing emin/emax ("is
+/// required"), unknown keys ("unknown parameter") and a non-object document. Does not range-check:
+/// call validate_params() (or remesh::check) on the result.
+ParsedParams params_from_json(const nlohmann::json& j);
+
+/// Parses string values (query string, CLI options): numbers in C locale, integers without
+/// fraction, booleans as true/false/1/0/yes/no/on/off (empty = true). Keys listed in `ignore`
+/// (e.g. "format") are skipped; other unknown keys are errors. Does not range-check.
+ParsedParams params_from_query(const std::map<std::string, std::string>& values,
+                               const std::vector<std::string>& ignore = {});
+
+/// Parsing errors plus the engine's range checks (remesh::check) for fields that parsed, and
+/// `iterations` against `max_iterations` (the service's limit, 0 = engine default). Defined in
+/// params_validation.cpp (links the remesher library).
+std::vector<FieldError> validate_params(ParsedParams& parsed, int max_iterations = 0);
+
+// ---- statistics as CSV --------------------------------------------------------------------------
+
+/// "iteration,vertices,edges,mean,..." (IterationStats field names in struct order), no newline.
+std::string stats_csv_header();
+/// One row, values in header order, shortest round-trip decimal form, no newline.
+std::string stats_csv_row(const IterationStats& s);
+/// Header and rows, each line ending in '\n'.
+std::string stats_to_csv(const std::vector<IterationStats>& rows);
+
+/// Shortest decimal text that reads back as exactly `v` ("0.1", "1e-07"); "null" for NaN/inf.
+std::string format_double(double v);
+
+}  // namespace remesh

@@ -1,0 +1,105 @@
+#include "upload.h"
+
+#include <algorithm>
+#include <cctype>
+
+#include "io/summary.h"
+
+namespace remesh::api {
+
+namespace {
+
+std::string lower(std::string_view s) {
+  std::string out(s);
+  for (char& c : out) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return out;
+}
+
+std::string_view trim(std::string_view s) {
+  while (!s.empty() && std::isspace(static_cast<unsigned char>(s.front()))) s.remove_prefix(1);
+  while (!s.empty() && std::isspace(static_cast<unsigned char>(s.back()))) s.remove_suffix(1);
+  return s;
+}
+
+}  // namespace
+
+std::optional<Format> format_from_content_type(std::string_view content_type) {
+  std::string t = lower(trim(content_type.substr(0, content_type.find(';'))));
+  if (t == "model/obj" || t == "application/x-tgif" || t == "text/x-obj") return Format::Obj;
+  if (t == "model/stl" || t == "application/sla" || t == "model/x.stl-binary" || t == "model/x.stl-ascii")
+    return Format::Stl;
+  if (t == "model/gltf-binary") return Format::Glb;
+  if (t == "model/gltf+json") return Format::Gltf;
+  if (t == "model/ply" || t == "application/ply" || t == "model/x-ply") return Format::Ply;
+  if (t == "model/off" || t == "model/x-off" || t == "application/off") return Format::Off;
+  return std::nullopt;
+}
+
+std::optional<Format> resolve_format(std::string_view format_param, std::string_view filename,
+                                     std::string_view content_type, std::vector<FieldError>& errors) {
+  if (!format_param.empty()) {
+    auto f = parse_format(format_param);
+    if (!f || *f == Format::Xyz) {
+      errors.push_back({"format", "unknown mesh format '" + std::string(format_param.substr(0, 40)) +
+                                      "' (obj, off, ply, stl, gltf, glb)"});
+      return std::nullopt;
+    }
+    return f;
+  }
+  if (filename.find('.') != std::string_view::npos) {
+    auto f = parse_format(filename);
+    if (f && *f != Format::Xyz) return f;
+  }
+  return format_from_content_type(content_type);
+}
+
+std::string safe_stem(std::string_view filename) {
+  auto slash = filename.find_last_of("/\\");
+  if (slash != std::string_view::npos) filename.remove_prefix(slash + 1);
+  auto dot = filename.find_last_of('.');
+  if (dot != std::string_view::npos && dot > 0) filename = filename.substr(0, dot);
+  std::string out;
+  for (char c : filename) {
+    if (out.size() >= 80) break;
+    bool ok = std::isalnum(static_cast<unsigned char>(c)) || c == '.' || c == '_' || c == '-';
+    out += ok ? c : '_';
+  }
+  while (!out.empty() && out.front() == '.') out.erase(out.begin());
+  return out.empty() ? "mesh" : out;
+}
+
+PreparedJob prepare_job(std::string_view bytes, std::string_view filename, std::optional<Format> format,
+                        ParsedParams params, const UploadLimits& limits) {
+  std::vector<FieldError> errors = validate_params(params, limits.max_iterations);
+  if (!errors.empty()) throw ParamsError(std::move(errors));
+  if (limits.max_output_faces > 0) params.params.max_output_faces = limits.max_output_faces;
+
+  ReadOptions options;
+  options.format = format;
+  options.weld = params.weld;
+  options.max_faces = limits.max_faces;
+  LoadedMesh loaded = read_mesh(bytes, options);
+  if (limits.max_faces > 0 && loaded.mesh.n_faces() > limits.max_faces)
+    throw LimitError("the mesh has " + std::to_string(loaded.mesh.n_faces()) + " faces, more than the limit of " +
+                     std::to_string(limits.max_faces));
+  std::size_t estimate = estimate_output_faces(loaded.mesh, params.params);
+  if (params.params.max_output_faces > 0 && estimate > params.params.max_output_faces)
+    throw LimitError("the result would have about " + std::to_string(estimate) + " faces, more than the limit of " +
+                     std::to_string(params.params.max_output_faces) + "; raise emin/emax");
+
+  PreparedJob job{JobRecord{}, std::move(loaded)};
+  JobRecord& r = job.record;
+  r.id = new_job_id();
+  r.state = JobState::Queued;
+  r.created_at = now_seconds();
+  r.params = params.params;
+  r.weld = params.weld;
+  r.filename = std::string(filename.substr(0, 200));
+  r.format = std::string(format_name(job.mesh.format));
+  r.bytes = bytes.size();
+  r.summary = summarize(job.mesh.mesh);
+  r.repairs = job.mesh.repairs;
+  return job;
+}
+
+}  // namespace remesh::api

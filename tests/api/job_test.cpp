@@ -1,0 +1,107 @@
+// The job model: states, ids, and the job document's shape and round trip.
+#include <catch2/catch.hpp>
+
+#include <set>
+
+#include "api/job.h"
+#include "api/problem.h"
+
+using nlohmann::json;
+using namespace remesh;
+using namespace remesh::api;
+
+TEST_CASE("job ids are 32 hex characters and distinct", "[api][job]") {
+  std::set<std::string> ids;
+  for (int i = 0; i < 200; ++i) {
+    std::string id = new_job_id();
+    CHECK(is_valid_job_id(id));
+    ids.insert(id);
+  }
+  CHECK(ids.size() == 200);
+  for (const char* bad : {"", "abc", "../../etc/passwd", "0123456789abcdef0123456789abcdeF",
+                          "0123456789abcdef0123456789abcde", "0123456789abcdef0123456789abcdef0",
+                          "0123456789abcdef/123456789abcdef"})
+    CHECK_FALSE(is_valid_job_id(bad));
+}
+
+TEST_CASE("state names round trip; final states", "[api][job]") {
+  for (JobState s : {JobState::Queued, JobState::Running, JobState::Succeeded, JobState::Failed,
+                     JobState::Cancelling, JobState::Cancelled})
+    CHECK(parse_state(state_name(s)) == s);
+  CHECK_FALSE(parse_state("done"));
+  CHECK(is_final(JobState::Succeeded));
+  CHECK(is_final(JobState::Cancelled));
+  CHECK_FALSE(is_final(JobState::Cancelling));
+}
+
+TEST_CASE("job document: fields, links only when succeeded, round trip", "[api][job]") {
+  JobRecord r;
+  r.id = new_job_id();
+  r.created_at = 1'700'000'000.25;
+  r.params.e_min = 0.5;
+  r.params.e_max = 1.0;
+  r.params.iterations = 10;
+  r.filename = "bunny.obj";
+  r.format = "obj";
+  r.bytes = 1234;
+  r.summary = json{{"vertices", 3}};
+  json doc = job_to_json(r, "/api/v1", r.created_at + 2);
+  CHECK(doc["id"] == r.id);
+  CHECK(doc["state"] == "queued");
+  CHECK(doc["created_at"] == "2023-11-14T22:13:20.250Z");
+  CHECK(doc["started_at"].is_null());
+  CHECK(doc["latest"].is_null());
+  CHECK(doc["outcome"].is_null());
+  CHECK(doc["error"].is_null());
+  CHECK(doc["params"]["emin"] == 0.5);
+  CHECK(doc["params"]["weld"] == false);
+  CHECK(doc["progress"]["iterations"] == 10);
+  CHECK(doc["timings"]["queued_seconds"] == Approx(2.0));
+  CHECK(doc["links"]["self"] == "/api/v1/jobs/" + r.id);
+  CHECK(doc["links"]["input"] == "/api/v1/jobs/" + r.id + "/result?mesh=input&format=glb");
+  CHECK_FALSE(doc["links"].contains("results"));
+
+  r.state = JobState::Succeeded;
+  r.started_at = r.created_at + 1;
+  r.finished_at = r.created_at + 4;
+  r.outcome = "converged";
+  IterationStats last;
+  last.iteration = 9;
+  last.mean = 0.75;
+  r.latest = last;
+  r.iteration = 9;
+  doc = job_to_json(r, "/api/v1", r.created_at + 100);
+  CHECK(doc["timings"]["queued_seconds"] == Approx(1.0));
+  CHECK(doc["timings"]["run_seconds"] == Approx(3.0));
+  REQUIRE(doc["links"].contains("results"));
+  CHECK(doc["links"]["results"]["remeshed"].size() == 5);
+  CHECK(doc["links"]["results"]["dual"]["xyz"] == "/api/v1/jobs/" + r.id + "/result?mesh=dual&format=xyz");
+
+  JobRecord back = job_from_json(doc);
+  CHECK(back.id == r.id);
+  CHECK(back.state == JobState::Succeeded);
+  CHECK(back.created_at == Approx(r.created_at));
+  CHECK(*back.finished_at == Approx(*r.finished_at));
+  CHECK(back.params.e_max == 1.0);
+  CHECK(back.latest->mean == 0.75);
+  CHECK(back.outcome == std::optional<std::string>("converged"));
+
+  json broken = doc;
+  broken["state"] = "sleeping";
+  CHECK_THROWS_AS(job_from_json(broken), std::runtime_error);
+  broken = doc;
+  broken["id"] = "../x";
+  CHECK_THROWS_AS(job_from_json(broken), std::runtime_error);
+}
+
+TEST_CASE("problems carry status, title, detail and field errors", "[api][problem]") {
+  Problem p = make_problem(422, "bad", {{"emin", "is required"}});
+  CHECK(p.status == 422);
+  CHECK(p.body["title"] == "Unprocessable Content");
+  CHECK(p.body["errors"][0]["field"] == "emin");
+  CHECK(problem_from_exception(MeshError("line 3: bad face")).status == 422);
+  CHECK(problem_from_exception(MeshError("line 3: bad face")).body["detail"] == "line 3: bad face");
+  CHECK(problem_from_exception(LimitError("too many")).status == 413);
+  CHECK(problem_from_exception(ParamsError(std::vector<FieldError>{{"rings", "1..4"}})).body["errors"].size() == 1);
+  CHECK(problem_from_exception(std::logic_error("x")).status == 500);
+}

@@ -1,0 +1,179 @@
+// Tables of parameter inputs and the field errors they must give; JSON/CSV shapes of engine values.
+#include <catch2/catch.hpp>
+
+#include <algorithm>
+#include <set>
+#include <sstream>
+
+#include "api/json_codec.h"
+
+using nlohmann::json;
+using namespace remesh;
+
+namespace {
+
+std::set<std::string> fields_of(const std::vector<FieldError>& errors) {
+  std::set<std::string> s;
+  for (const auto& e : errors) s.insert(e.field);
+  return s;
+}
+
+}  // namespace
+
+TEST_CASE("params_from_json: valid documents parse into Params", "[api][params]") {
+  ParsedParams p = params_from_json(json::parse(
+      R"({"emin":0.5,"emax":1.5,"iterations":7,"rings":3,"relax_every":2,"flip_factor":0.25,"run_all_iterations":true,"weld":true})"));
+  REQUIRE(p.ok());
+  CHECK(p.params.e_min == 0.5);
+  CHECK(p.params.e_max == 1.5);
+  CHECK(p.params.iterations == 7);
+  CHECK(p.params.rings == 3);
+  CHECK(p.params.relax_every == 2);
+  CHECK(p.params.flip_factor == 0.25);
+  CHECK(p.params.run_all_iterations);
+  CHECK(p.weld);
+
+  ParsedParams d = params_from_json(json::parse(R"({"emin":1,"emax":2,"iterations":5.0})"));
+  REQUIRE(d.ok());
+  CHECK(d.params.iterations == 5);
+  CHECK(d.params.rings == Params{}.rings);
+  CHECK_FALSE(d.weld);
+}
+
+TEST_CASE("params_from_json: every bad field is reported", "[api][params]") {
+  struct Row {
+    const char* doc;
+    std::set<std::string> fields;
+  };
+  const Row rows[] = {
+      {R"({})", {"emin", "emax"}},
+      {R"({"emin":1})", {"emax"}},
+      {R"({"emin":"1","emax":2})", {"emin"}},
+      {R"({"emin":1,"emax":2,"iterations":1.5})", {"iterations"}},
+      {R"({"emin":1,"emax":2,"iterations":"ten","rings":[1]})", {"iterations", "rings"}},
+      {R"({"emin":1,"emax":2,"run_all_iterations":"yes"})", {"run_all_iterations"}},
+      {R"({"emin":1,"emax":2,"weld":1})", {"weld"}},
+      {R"({"emin":1,"emax":2,"flip_factor":null})", {"flip_factor"}},
+      {R"({"emin":1,"emax":2,"iterations":99999999999})", {"iterations"}},
+      {R"({"emin":1,"emax":2,"colour":"red"})", {"colour"}},
+      {R"({"emax":true,"relax_every":{}})", {"emin", "emax", "relax_every"}},
+      {R"([1,2])", {"params"}},
+  };
+  for (const Row& row : rows) {
+    INFO(row.doc);
+    ParsedParams p = params_from_json(json::parse(row.doc));
+    CHECK(fields_of(p.errors) == row.fields);
+    for (const auto& e : p.errors) CHECK_FALSE(e.message.empty());
+  }
+}
+
+TEST_CASE("params_from_query: strings parse strictly", "[api][params]") {
+  using Map = std::map<std::string, std::string>;
+  ParsedParams ok = params_from_query(Map{{"emin", "1e-2"}, {"emax", " 0.03"}, {"iterations", "20"},
+                                          {"run_all_iterations", ""}, {"weld", "off"}, {"format", "obj"}},
+                                      {"format"});
+  REQUIRE(ok.ok());
+  CHECK(ok.params.e_min == 0.01);
+  CHECK(ok.params.e_max == 0.03);
+  CHECK(ok.params.iterations == 20);
+  CHECK(ok.params.run_all_iterations);
+  CHECK_FALSE(ok.weld);
+
+  struct Row {
+    Map values;
+    std::set<std::string> fields;
+  };
+  const Row rows[] = {
+      {{}, {"emin", "emax"}},
+      {{{"emin", "abc"}, {"emax", "2"}}, {"emin"}},
+      {{{"emin", "1"}, {"emax", "2x"}}, {"emax"}},
+      {{{"emin", "nan"}, {"emax", "inf"}}, {"emin", "emax"}},
+      {{{"emin", "1"}, {"emax", "2"}, {"iterations", "2.5"}}, {"iterations"}},
+      {{{"emin", "1"}, {"emax", "2"}, {"rings", ""}}, {"rings"}},
+      {{{"emin", "1"}, {"emax", "2"}, {"run_all_iterations", "maybe"}}, {"run_all_iterations"}},
+      {{{"emin", "1"}, {"emax", "2"}, {"format", "obj"}}, {"format"}},  // not ignored here
+      {{{"emin", "1"}, {"emax", "2"}, {"itrations", "3"}}, {"itrations"}},
+  };
+  for (const Row& row : rows) {
+    std::ostringstream what;
+    for (const auto& [k, v] : row.values) what << k << "=" << v << "&";
+    INFO(what.str());
+    CHECK(fields_of(params_from_query(row.values).errors) == row.fields);
+  }
+}
+
+TEST_CASE("Params and summaries map to the documented JSON names", "[api][json]") {
+  Params p;
+  p.e_min = 0.1;
+  p.e_max = 0.2;
+  json j = p;
+  for (const char* k : {"emin", "emax", "iterations", "rings", "relax_every", "flip_factor", "run_all_iterations"})
+    CHECK(j.contains(k));
+  CHECK(j["emin"] == 0.1);
+  // Round trip through the parser.
+  ParsedParams back = params_from_json(j);
+  REQUIRE(back.ok());
+  CHECK(back.params.e_max == 0.2);
+
+  MeshSummary s;
+  s.vertices = 12;
+  s.faces = 20;
+  s.edges = 30;
+  s.components = 2;
+  s.euler = 2;
+  ComponentSummary closed;
+  closed.closed = true;
+  closed.genus = 1;
+  ComponentSummary open;
+  open.closed = false;
+  s.per_component = {closed, open};
+  s.bbox_max = Vec3(1, 2, 3);
+  s.bbox_diagonal = std::sqrt(14.0);
+  s.mean_edge = 0.5;
+  json sj = summary_json(s, {Repair{"welded", 3, "3 vertices welded"}});
+  CHECK(sj["vertices"] == 12);
+  CHECK(sj["genus"] == json::array({1}));
+  CHECK(sj["bbox"]["max"] == json::array({1.0, 2.0, 3.0}));
+  CHECK(sj["bbox"]["diagonal"] == s.bbox_diagonal);
+  CHECK(sj["edge_length"]["mean"] == 0.5);
+  for (const char* k : {"boundary_loops", "boundary_edges", "euler", "area", "components", "faces", "edges"})
+    CHECK(sj.contains(k));
+  REQUIRE(sj["repairs"].size() == 1);
+  CHECK(sj["repairs"][0]["kind"] == "welded");
+  CHECK(sj["repairs"][0]["count"] == 3);
+}
+
+TEST_CASE("IterationStats: JSON round trip and CSV in struct order", "[api][stats]") {
+  IterationStats s;
+  s.iteration = 3;
+  s.vertices = 100;
+  s.edges = 300;
+  s.mean = 0.1;
+  s.deviation = 1e-7;
+  s.regular_percent = 87.5;
+  s.small = 4;
+  s.big = 5;
+  s.inside_fraction = 0.9;
+  s.splits = 6;
+  s.collapses = 7;
+  s.flips = 8;
+  s.seconds = 0.015625;
+  s.max_projection_distance = 2.5e-3;
+  json j = s;
+  CHECK(j.size() == 14);
+  IterationStats back = j.get<IterationStats>();
+  CHECK(back.iteration == 3);
+  CHECK(back.deviation == 1e-7);
+  CHECK(back.flips == 8);
+  CHECK(back.max_projection_distance == 2.5e-3);
+
+  const std::string header = stats_csv_header();
+  CHECK(header ==
+        "iteration,vertices,edges,mean,deviation,regular_percent,small,big,inside_fraction,splits,collapses,flips,"
+        "seconds,max_projection_distance");
+  CHECK(stats_csv_row(s) == "3,100,300,0.1,1e-07,87.5,4,5,0.9,6,7,8,0.015625,0.0025");
+  std::string csv = stats_to_csv({s, s});
+  CHECK(std::count(csv.begin(), csv.end(), '\n') == 3);
+  CHECK(format_double(0.1) == "0.1");
+  CHECK(format_double(std::nan("")) == "null");
+}
