@@ -1,0 +1,63 @@
+/// \file cmd_dual.cpp
+/// `remesh dual IN OUT`: the trivalent dual of a mesh as it is (centroids lie on the triangles, so
+/// no projection is needed).
+
+#include <iostream>
+#include <map>
+
+#include "args.h"
+#include "commands.h"
+#include "dual/trivalent_dual.h"
+
+namespace remesh::cli {
+namespace {
+
+const std::vector<OptionSpec> kSpec = {
+    {"weld", "", "weld duplicate vertices at the same position while reading"},
+    {"quiet", "", "do not report counts"},
+};
+
+/// "1200 faces: 12 pentagons, 1188 hexagons" style histogram of face sizes.
+void print_dual_counts(std::ostream& out, const std::string& path, const PolyMesh& dual) {
+  std::map<std::size_t, std::size_t> sizes;
+  for (auto f : dual.faces()) ++sizes[dual.valence(f)];
+  out << "wrote " << path << ": " << dual.n_vertices() << " vertices, " << dual.n_edges() << " edges, "
+      << dual.n_faces() << " faces (";
+  bool first = true;
+  for (auto [size, count] : sizes) {
+    out << (first ? "" : ", ") << count << " with " << size << " sides";
+    first = false;
+  }
+  out << ")\n";
+}
+
+}  // namespace
+
+int run_dual(const std::vector<std::string>& args) {
+  if (wants_help(args)) {
+    std::cout << format_help("remesh dual IN OUT [--weld]",
+                             "Writes the trivalent dual of IN: one vertex per triangle (its centroid), one\n"
+                             "polygon per interior vertex, oriented like IN; boundary vertices give no face.\n"
+                             "OUT by extension: .obj/.off/.ply (polygons), .glb (triangle fans plus a LINES\n"
+                             "primitive of the polygon edges), .stl (fans), .xyz (one carbon atom per vertex).",
+                             kSpec);
+    return 0;
+  }
+  const Args a = parse_args(args, kSpec, 2, 2);
+  const std::string& in = a.positional[0];
+  const std::string& out = a.positional[1];
+  require_input_file(in);
+  require_output_format(out);
+  ReadOptions options;
+  options.weld = a.has("weld");
+  const LoadedMesh loaded = read_mesh_file(in, options);
+  const PolyMesh dual = trivalent_dual(loaded.mesh);
+  write_mesh_file(to_soup(dual), out);
+  if (!a.has("quiet")) {
+    print_repairs(std::cerr, loaded.repairs);
+    print_dual_counts(std::cerr, out, dual);
+  }
+  return 0;
+}
+
+}  // namespace remesh::cli

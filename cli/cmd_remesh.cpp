@@ -1,0 +1,179 @@
+/// \file cmd_remesh.cpp
+/// `remesh IN OUT --emin A --emax B [...]`: Algorithm 1 on IN, OUT written even when cancelled;
+/// optionally the dual of the result projected onto IN, and the statistics rows as CSV or JSON.
+
+#include <algorithm>
+#include <climits>
+#include <cstdio>
+#include <fstream>
+#include <iostream>
+#include <optional>
+
+#include "args.h"
+#include "commands.h"
+#include "dual/trivalent_dual.h"
+#include "interrupt.h"
+#include "io/summary.h"
+#include "json_out.h"
+#include "progress.h"
+#include "remesh/equalize.h"
+#include "remesh/reference_surface.h"
+
+namespace remesh::cli {
+namespace {
+
+const std::vector<OptionSpec> kSpec = {
+    {"emin", "A", "smallest allowed edge length, > 0 (required)"},
+    {"emax", "B", "largest allowed edge length, > A (required)"},
+    {"iterations", "N", "iterations n, 1..1000 (default 100)"},
+    {"rings", "K", "rings k of the low-pass filter, 1..4 (default 2)"},
+    {"relax-every", "PR", "replace the reference surface every PR iterations; 0 = never (default 0)"},
+    {"flip-factor", "F", "a flip may lower the min angle to F times its old value, 0..1 (default 0.5)"},
+    {"all-iterations", "", "run all N iterations instead of stopping once every edge is inside"},
+    {"dual", "DUAL_OUT", "also write the trivalent dual of the result, projected onto IN"},
+    {"stats", "FILE", "write the per-iteration statistics to FILE.csv or FILE.json"},
+    {"threads", "T", "worker threads; 0 = all cores (default 0; results do not depend on it)"},
+    {"max-faces", "N", "refuse inputs and estimated outputs over N faces; 0 = no limit (default 20000000)"},
+    {"weld", "", "weld duplicate vertices at the same position while reading"},
+    {"quiet", "", "print nothing but errors"},
+};
+
+/// The CLI option a Params field comes from ("relax_every" -> "--relax-every").
+std::string option_for(std::string field) {
+  std::replace(field.begin(), field.end(), '_', '-');
+  return "--" + field;
+}
+
+struct Job {
+  std::string in, out;
+  std::optional<std::string> dual_out, stats_out;
+  Params params;
+  ReadOptions read;
+  bool quiet = false;
+};
+
+Job parse_job(const std::vector<std::string>& args) {
+  const Args a = parse_args(args, kSpec, 2, 2);
+  Job job;
+  job.in = a.positional[0];
+  job.out = a.positional[1];
+  if (!a.has("emin") || !a.has("emax"))
+    throw UsageError(std::string("missing required option") +
+                     (!a.has("emin") && !a.has("emax") ? "s --emin and --emax" : a.has("emin") ? " --emax" : " --emin"));
+  Params& p = job.params;
+  p.e_min = *a.get_double("emin");
+  p.e_max = *a.get_double("emax");
+  if (auto v = a.get_int("iterations", INT_MIN, INT_MAX)) p.iterations = static_cast<int>(*v);
+  if (auto v = a.get_int("rings", INT_MIN, INT_MAX)) p.rings = static_cast<int>(*v);
+  if (auto v = a.get_int("relax-every", INT_MIN, INT_MAX)) p.relax_every = static_cast<int>(*v);
+  if (auto v = a.get_double("flip-factor")) p.flip_factor = *v;
+  if (auto v = a.get_int("threads", 0, 4096)) p.threads = static_cast<unsigned>(*v);
+  if (auto v = a.get_int("max-faces", 0, LLONG_MAX)) {
+    p.max_output_faces = static_cast<std::size_t>(*v);
+    job.read.max_faces = static_cast<std::size_t>(*v);
+  }
+  p.run_all_iterations = a.has("all-iterations");
+  job.read.weld = a.has("weld");
+  job.quiet = a.has("quiet");
+  job.dual_out = a.get("dual");
+  job.stats_out = a.get("stats");
+
+  auto errors = check(p);
+  if (!errors.empty()) {
+    for (auto& e : errors) e.field = option_for(e.field);
+    throw ParamsError(std::move(errors));
+  }
+  require_input_file(job.in);
+  require_output_format(job.out);
+  if (job.dual_out) require_output_format(*job.dual_out);
+  if (job.stats_out) {
+    const auto& s = *job.stats_out;
+    auto ends = [&](const char* ext) { return s.size() > 4 && s.compare(s.size() - 4, 4, ext) == 0; };
+    if (!ends(".csv") && !(s.size() > 5 && s.compare(s.size() - 5, 5, ".json") == 0))
+      throw UsageError("--stats: '" + s + "' must end in .csv or .json");
+  }
+  return job;
+}
+
+void write_text_file(const std::string& path, const std::string& text) {
+  std::ofstream f(path, std::ios::binary);
+  if (!f) throw std::runtime_error("cannot write " + path);
+  f << text;
+  if (!f.flush()) throw std::runtime_error("write failed: " + path);
+}
+
+const char* outcome_name(Outcome o) {
+  switch (o) {
+    case Outcome::Converged: return "converged";
+    case Outcome::Cancelled: return "cancelled";
+    case Outcome::Completed: break;
+  }
+  return "completed";
+}
+
+void print_final(const TriMesh& mesh, const Job& job, const Result& result) {
+  const IterationStats q = measure(mesh, job.params.e_min, job.params.e_max, job.params.threads);
+  const MeshSummary s = summarize(mesh);
+  std::printf("result: %zu vertices, %zu edges, %zu faces\n", s.vertices, s.edges, s.faces);
+  std::printf("  edges inside [%g, %g]: %.3f %% (%zu small, %zu big)\n", job.params.e_min, job.params.e_max,
+              100.0 * q.inside_fraction, q.small, q.big);
+  std::printf("  regular vertices:     %.2f %%\n", q.regular_percent);
+  std::printf("  edge length:          mean %.6g, deviation %.4g, min %.6g, max %.6g\n", q.mean, q.deviation,
+              s.min_edge, s.max_edge);
+  std::printf("  outcome:              %s after %d iteration%s, %.2f s\n", outcome_name(result.outcome),
+              result.iterations_done, result.iterations_done == 1 ? "" : "s", result.seconds);
+  std::fflush(stdout);
+}
+
+}  // namespace
+
+int run_remesh(const std::vector<std::string>& args) {
+  if (wants_help(args)) {
+    std::cout << format_help(
+        "remesh IN OUT --emin A --emax B [OPTIONS]",
+        "Remeshes IN by iterative edge equalization so that its edge lengths lie in [A, B] and writes\n"
+        "OUT (.obj .off .ply .stl .glb .xyz). Shows the statistics every 5 iterations and a final\n"
+        "quality summary. Ctrl-C stops after the current step and still writes the (valid) mesh.\n"
+        "For dual edges (bond lengths) in [a, b], ask for the primal interval [a*sqrt(3), b*sqrt(3)].",
+        kSpec);
+    return 0;
+  }
+  const Job job = parse_job(args);
+  LoadedMesh loaded = read_mesh_file(job.in, job.read);
+  if (!job.quiet) print_repairs(std::cerr, loaded.repairs);
+  std::optional<ReferenceSurface> reference;
+  if (job.dual_out) reference.emplace(loaded.mesh);
+
+  TriMesh& mesh = loaded.mesh;
+  std::vector<IterationStats> rows;
+  Progress progress(job.params.iterations, job.quiet);
+  std::stop_source stop;
+  Result result;
+  {
+    InterruptGuard guard(stop);
+    result = equalize(
+        mesh, job.params,
+        [&](const IterationStats& row) {
+          rows.push_back(row);
+          progress.update(row);
+        },
+        stop.get_token());
+  }
+  progress.finish();
+
+  write_mesh_file(to_soup(mesh), job.out);
+  if (job.dual_out) write_mesh_file(to_soup(trivalent_dual(mesh, &*reference)), *job.dual_out);
+  if (job.stats_out) {
+    const bool json = job.stats_out->size() > 5 && job.stats_out->ends_with(".json");
+    write_text_file(*job.stats_out, json ? stats_json(rows) : stats_csv(rows));
+  }
+  if (!job.quiet) print_final(mesh, job, result);
+  if (result.outcome == Outcome::Cancelled) {
+    std::cerr << "remesh: cancelled after " << result.iterations_done << " iterations; wrote the partial mesh to "
+              << job.out << "\n";
+    return 1;
+  }
+  return 0;
+}
+
+}  // namespace remesh::cli

@@ -1,0 +1,29 @@
+#pragma once
+/// \file commands.h
+/// The commands of the `remesh` tool and the helpers they share. Each command takes its own
+/// arguments (without the program and command names) and returns the exit code; errors are thrown
+/// and mapped to exit codes by main(): UsageError/ParamsError -> 2, MeshError/LimitError -> 3,
+/// anything else -> 1.
+
+#include <iosfwd>
+#include <string>
+#include <vector>
+
+#include "io/mesh_io.h"
+
+namespace remesh::cli {
+
+int run_info(const std::vector<std::string>& args);
+int run_convert(const std::vector<std::string>& args);
+int run_dual(const std::vector<std::string>& args);
+int run_remesh(const std::vector<std::string>& args);
+
+/// Throws UsageError unless `path` names an existing regular file.
+void require_input_file(const std::string& path);
+/// The format to write `path` in, from its extension. Throws UsageError for an unknown extension
+/// and for .gltf (only the binary .glb is written).
+Format require_output_format(const std::string& path);
+/// One line per repair ("  kind (count): detail"); nothing when there were none.
+void print_repairs(std::ostream& out, const std::vector<Repair>& repairs);
+
+}  // namespace remesh::cli

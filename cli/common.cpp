@@ -1,0 +1,34 @@
+/// \file common.cpp
+/// Helpers shared by the commands.
+
+#include <filesystem>
+#include <ostream>
+
+#include "args.h"
+#include "commands.h"
+
+namespace remesh::cli {
+
+void require_input_file(const std::string& path) {
+  std::error_code ec;
+  const auto status = std::filesystem::status(path, ec);
+  if (ec || !std::filesystem::exists(status)) throw UsageError("input file not found: " + path);
+  if (std::filesystem::is_directory(status)) throw UsageError("input is a directory, not a mesh file: " + path);
+}
+
+Format require_output_format(const std::string& path) {
+  auto format = parse_format(path);
+  if (!format)
+    throw UsageError("cannot tell the output format from '" + path +
+                     "' (use .obj, .off, .ply, .stl, .glb or .xyz)");
+  if (*format == Format::Gltf)
+    throw UsageError("writing text glTF is not supported: name the output .glb (binary glTF) instead of '" +
+                     path + "'");
+  return *format;
+}
+
+void print_repairs(std::ostream& out, const std::vector<Repair>& repairs) {
+  for (const auto& r : repairs) out << "  " << r.kind << " (" << r.count << "): " << r.detail << "\n";
+}
+
+}  // namespace remesh::cli
