@@ -1,0 +1,50 @@
+/// \file read_mesh.cpp
+/// read_mesh / read_mesh_file: choose the format, run its reader, validate and repair.
+
+#include <fstream>
+#include <sstream>
+
+#include "io/parse_util.h"
+#include "io/soup.h"
+
+namespace remesh {
+
+LoadedMesh read_mesh(std::string_view bytes, const ReadOptions& options) {
+  if (bytes.empty()) throw MeshError("empty input: no bytes to read");
+  std::optional<Format> format = options.format ? options.format : detect_format(bytes);
+  if (!format) throw MeshError("unrecognised mesh format (supported: OBJ, OFF, PLY, STL, glTF, GLB)");
+  io::RawSoup soup;
+  switch (*format) {
+    case Format::Obj: soup = io::read_obj(bytes, options); break;
+    case Format::Off: soup = io::read_off(bytes, options); break;
+    case Format::Ply: soup = io::read_ply(bytes, options); break;
+    case Format::Stl: soup = io::read_stl(bytes, options); break;
+    case Format::Gltf: soup = io::read_gltf(bytes, false, options); break;
+    case Format::Glb: soup = io::read_gltf(bytes, true, options); break;
+    case Format::Xyz: throw MeshError("unsupported input format xyz (a point list has no faces)");
+  }
+  LoadedMesh out{TriMesh(), *format, std::move(soup.repairs)};
+  out.mesh = io::build_mesh(std::move(soup), options, out.repairs);
+  return out;
+}
+
+LoadedMesh read_mesh_file(const std::string& path, ReadOptions options) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw MeshError("cannot open '" + path + "'");
+  std::ostringstream buffer;
+  buffer << in.rdbuf();
+  if (in.bad()) throw MeshError("cannot read '" + path + "'");
+  const std::string bytes = std::move(buffer).str();
+  if (!options.format) {
+    options.format = parse_format(path);
+    // A .gltf may be GLB in disguise and vice versa; trust the content when it is clear.
+    if (options.format == Format::Gltf || options.format == Format::Glb) {
+      auto sniffed = detect_format(bytes);
+      if (sniffed == Format::Gltf || sniffed == Format::Glb) options.format = sniffed;
+    }
+  }
+  if (bytes.empty()) throw MeshError("'" + path + "' is empty");
+  return read_mesh(bytes, options);
+}
+
+}  // namespace remesh

@@ -1,0 +1,141 @@
+/// \file read_off.cpp
+/// OFF (Geomview/Princeton): ASCII with optional C/N/ST prefixes (extra per-vertex values and face
+/// colours are ignored), and "OFF BINARY" (big-endian int32 counts, float32 coordinates).
+
+#include <string>
+
+#include "io/parse_util.h"
+#include "io/soup.h"
+
+namespace remesh::io {
+
+namespace {
+
+[[noreturn]] void fail_at(std::size_t line, const std::string& what) {
+  fail("OFF line " + std::to_string(line) + ": " + what);
+}
+
+/// Next line with content (comments after '#' removed); false at the end.
+bool next_content_line(LineScanner& lines, std::string_view& line) {
+  while (lines.next(line)) {
+    std::size_t hash = line.find('#');
+    if (hash != std::string_view::npos) line = line.substr(0, hash);
+    std::string_view probe = line, tok;
+    if (next_token(probe, tok)) return true;
+  }
+  return false;
+}
+
+std::int64_t parse_count(std::string_view& rest, std::size_t line, const char* what) {
+  std::string_view tok;
+  std::int64_t v = 0;
+  if (!next_token(rest, tok)) fail_at(line, std::string("missing ") + what + " count");
+  if (!parse_int(tok, v) || v < 0) fail_at(line, std::string("bad ") + what + " count " + quote(tok));
+  return v;
+}
+
+void check_counts(std::int64_t nv, std::int64_t nf, std::size_t bytes_left, std::size_t min_v,
+                  std::size_t min_f, const ReadOptions& options) {
+  check_face_limit(static_cast<std::uint64_t>(nf), options, "OFF");
+  // Each vertex and face needs some bytes: refuse absurd counts before allocating anything.
+  if (static_cast<std::uint64_t>(nv) > bytes_left / min_v ||
+      static_cast<std::uint64_t>(nf) > bytes_left / min_f ||
+      static_cast<std::uint64_t>(nv) * min_v + static_cast<std::uint64_t>(nf) * min_f > bytes_left + 2)
+    fail("OFF header claims " + std::to_string(nv) + " vertices and " + std::to_string(nf) +
+         " faces, but only " + std::to_string(bytes_left) + " bytes follow (file truncated?)");
+}
+
+RawSoup read_off_binary(std::string_view bytes, std::size_t data_start, const ReadOptions& options) {
+  ByteReader r(bytes, data_start);
+  if (!r.has(12)) fail("binary OFF: truncated header (need 3 int32 counts)");
+  std::int64_t nv = r.read<std::int32_t>(true), nf = r.read<std::int32_t>(true);
+  r.skip(4);
+  if (nv < 0 || nf < 0) fail("binary OFF: negative vertex or face count");
+  check_counts(nv, nf, r.remaining(), 12, 8, options);
+  RawSoup soup;
+  soup.points.reserve(static_cast<std::size_t>(nv));
+  for (std::int64_t i = 0; i < nv; ++i) {
+    double c[3];
+    for (double& v : c) v = r.read<float>(true);
+    soup.points.emplace_back(c[0], c[1], c[2]);
+  }
+  for (std::int64_t f = 0; f < nf; ++f) {
+    if (!r.has(4)) fail("binary OFF: truncated at face " + std::to_string(f) + " of " + std::to_string(nf));
+    std::int64_t n = r.read<std::int32_t>(true);
+    if (n < 0 || !r.has(static_cast<std::uint64_t>(n) * 4 + 4))
+      fail("binary OFF: face " + std::to_string(f) + " declares " + std::to_string(n) +
+           " vertices but the file ends first");
+    for (std::int64_t k = 0; k < n; ++k) soup.indices.push_back(r.read<std::int32_t>(true));
+    std::int64_t colors = r.read<std::int32_t>(true);
+    if (colors < 0 || !r.has(static_cast<std::uint64_t>(colors) * 4))
+      fail("binary OFF: face " + std::to_string(f) + " has a bad colour count " + std::to_string(colors));
+    r.skip(static_cast<std::size_t>(colors) * 4);
+    soup.offsets.push_back(static_cast<std::uint32_t>(soup.indices.size()));
+  }
+  return soup;
+}
+
+}  // namespace
+
+RawSoup read_off(std::string_view bytes, const ReadOptions& options) {
+  LineScanner lines(bytes);
+  std::string_view line;
+  if (!next_content_line(lines, line)) fail("OFF: empty file");
+  std::string_view rest = line, keyword;
+  next_token(rest, keyword);
+  if (keyword.size() < 3 || keyword.substr(keyword.size() - 3) != "OFF")
+    fail("OFF line " + std::to_string(lines.line_number()) + ": expected the OFF keyword, found " + quote(keyword));
+  std::string_view prefix = keyword.substr(0, keyword.size() - 3);
+  if (prefix.find('4') != std::string_view::npos || prefix.find('n') != std::string_view::npos)
+    fail("OFF: only 3D OFF is supported, not " + quote(keyword));
+  std::string_view probe = rest, tok;
+  if (next_token(probe, tok) && tok == "BINARY") return read_off_binary(bytes, lines.position(), options);
+
+  if (!next_token(probe = rest, tok)) {  // counts on their own line
+    if (!next_content_line(lines, line)) fail("OFF: missing the vertex/face count line");
+    rest = line;
+  }
+  const std::size_t count_line = lines.line_number();
+  const std::int64_t nv = parse_count(rest, count_line, "vertex");
+  const std::int64_t nf = parse_count(rest, count_line, "face");
+  check_counts(nv, nf, lines.remaining(), 5, 7, options);
+
+  RawSoup soup;
+  soup.points.reserve(static_cast<std::size_t>(nv));
+  soup.point_lines.reserve(static_cast<std::size_t>(nv));
+  for (std::int64_t i = 0; i < nv; ++i) {
+    if (!next_content_line(lines, line))
+      fail("OFF: file ends after " + std::to_string(i) + " of " + std::to_string(nv) + " vertices");
+    rest = line;
+    double c[3];
+    for (double& v : c) {
+      if (!next_token(rest, tok)) fail_at(lines.line_number(), "vertex " + std::to_string(i) + " has fewer than 3 coordinates");
+      if (!parse_double(tok, v)) fail_at(lines.line_number(), "bad coordinate " + quote(tok) + " of vertex " + std::to_string(i));
+    }
+    soup.points.emplace_back(c[0], c[1], c[2]);
+    soup.point_lines.push_back(static_cast<std::uint32_t>(lines.line_number()));
+  }
+  soup.offsets.reserve(static_cast<std::size_t>(nf) + 1);
+  soup.face_lines.reserve(static_cast<std::size_t>(nf));
+  for (std::int64_t f = 0; f < nf; ++f) {
+    if (!next_content_line(lines, line))
+      fail("OFF: file ends after " + std::to_string(f) + " of " + std::to_string(nf) + " faces");
+    rest = line;
+    const std::size_t ln = lines.line_number();
+    std::int64_t n = 0;
+    if (!next_token(rest, tok) || !parse_int(tok, n) || n < 0)
+      fail_at(ln, "bad vertex count " + quote(tok) + " of face " + std::to_string(f));
+    for (std::int64_t k = 0; k < n; ++k) {
+      std::int64_t idx = 0;
+      if (!next_token(rest, tok))
+        fail_at(ln, "face " + std::to_string(f) + " declares " + std::to_string(n) + " vertices but lists " + std::to_string(k));
+      if (!parse_int(tok, idx)) fail_at(ln, "bad vertex index " + quote(tok) + " in face " + std::to_string(f));
+      soup.indices.push_back(idx);
+    }
+    soup.offsets.push_back(static_cast<std::uint32_t>(soup.indices.size()));
+    soup.face_lines.push_back(static_cast<std::uint32_t>(ln));
+  }
+  return soup;
+}
+
+}  // namespace remesh::io

@@ -1,0 +1,136 @@
+/// \file read_stl.cpp
+/// STL, ASCII and binary. STL has no shared vertices: corners are welded by exact position here
+/// (part of reading the format, not a repair). Binary is recognised by its size (84 + 50 n bytes),
+/// even when its header starts with "solid".
+
+#include <cstring>
+#include <string>
+#include <unordered_map>
+
+#include "io/parse_util.h"
+#include "io/soup.h"
+
+namespace remesh::io {
+
+namespace {
+
+/// Welds corners by exact position (-0 and +0 are one position; NaNs are kept apart so the
+/// validator can name them).
+class Welder {
+ public:
+  explicit Welder(RawSoup& soup) : soup_(soup) {}
+  std::int64_t add(const Vec3& p, std::uint32_t line) {
+    Key k{};
+    for (int i = 0; i < 3; ++i) {
+      double v = p[i] + 0.0;
+      std::memcpy(&k.bits[i], &v, 8);
+    }
+    bool finite = std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2]);
+    if (finite) {
+      auto [it, inserted] = map_.try_emplace(k, soup_.points.size());
+      if (!inserted) return static_cast<std::int64_t>(it->second);
+    }
+    soup_.points.push_back(p);
+    if (line > 0) soup_.point_lines.push_back(line);
+    return static_cast<std::int64_t>(soup_.points.size() - 1);
+  }
+
+ private:
+  struct Key {
+    std::uint64_t bits[3];
+    bool operator==(const Key& o) const { return std::memcmp(bits, o.bits, sizeof bits) == 0; }
+  };
+  struct Hash {
+    std::size_t operator()(const Key& k) const {
+      std::uint64_t h = 1469598103934665603ull;
+      for (std::uint64_t b : k.bits) h = (h ^ b) * 1099511628211ull ^ (h >> 29);
+      return static_cast<std::size_t>(h);
+    }
+  };
+  RawSoup& soup_;
+  std::unordered_map<Key, std::size_t, Hash> map_;
+};
+
+RawSoup read_binary_stl(std::string_view bytes, const ReadOptions& options) {
+  if (bytes.size() < 84) fail("binary STL: file has " + std::to_string(bytes.size()) + " bytes, less than the 84-byte header");
+  ByteReader r(bytes, 80);
+  const std::uint64_t n = r.read<std::uint32_t>(false);
+  check_face_limit(n, options, "STL");
+  if (84 + 50 * n > bytes.size())
+    fail("binary STL: header says " + std::to_string(n) + " triangles (" + std::to_string(84 + 50 * n) +
+         " bytes) but the file has " + std::to_string(bytes.size()) + " bytes (truncated?)");
+  RawSoup soup;
+  soup.points.reserve(n);
+  soup.indices.reserve(3 * n);
+  soup.offsets.reserve(n + 1);
+  Welder welder(soup);
+  for (std::uint64_t t = 0; t < n; ++t) {
+    r.skip(12);  // normal
+    for (int c = 0; c < 3; ++c) {
+      double x = r.read<float>(false), y = r.read<float>(false), z = r.read<float>(false);
+      soup.indices.push_back(welder.add(Vec3(x, y, z), 0));
+    }
+    r.skip(2);
+    soup.offsets.push_back(static_cast<std::uint32_t>(soup.indices.size()));
+  }
+  return soup;
+}
+
+[[noreturn]] void fail_at(std::size_t line, const std::string& what) {
+  fail("ASCII STL line " + std::to_string(line) + ": " + what);
+}
+
+RawSoup read_ascii_stl(std::string_view bytes, const ReadOptions& options) {
+  RawSoup soup;
+  Welder welder(soup);
+  LineScanner lines(bytes);
+  std::string_view line, tok;
+  bool in_loop = false;
+  std::size_t corners = 0;
+  while (lines.next(line)) {
+    std::string_view rest = line;
+    if (!next_token(rest, tok)) continue;
+    const std::size_t ln = lines.line_number();
+    if (tok == "outer") {
+      if (in_loop) fail_at(ln, "'outer loop' inside another loop");
+      in_loop = true;
+      corners = 0;
+      check_face_limit(soup.face_count() + 1, options, "STL");
+      soup.face_lines.push_back(static_cast<std::uint32_t>(ln));
+    } else if (tok == "vertex") {
+      if (!in_loop) fail_at(ln, "'vertex' outside 'outer loop'");
+      double c[3];
+      for (double& v : c) {
+        if (!next_token(rest, tok)) fail_at(ln, "vertex has fewer than 3 coordinates");
+        if (!parse_double(tok, v)) fail_at(ln, "bad vertex coordinate " + quote(tok));
+      }
+      soup.indices.push_back(welder.add(Vec3(c[0], c[1], c[2]), static_cast<std::uint32_t>(ln)));
+      ++corners;
+    } else if (tok == "endloop") {
+      if (!in_loop) fail_at(ln, "'endloop' without 'outer loop'");
+      in_loop = false;
+      soup.offsets.push_back(static_cast<std::uint32_t>(soup.indices.size()));
+    } else if (tok != "solid" && tok != "facet" && tok != "endfacet" && tok != "endsolid") {
+      fail_at(ln, "unexpected keyword " + quote(tok));
+    }
+  }
+  if (in_loop) fail("ASCII STL: file ends inside a facet (truncated?)");
+  (void)corners;
+  return soup;
+}
+
+}  // namespace
+
+RawSoup read_stl(std::string_view bytes, const ReadOptions& options) {
+  if (bytes.size() >= 84) {
+    ByteReader r(bytes, 80);
+    const std::uint64_t n = r.read<std::uint32_t>(false);
+    if (84 + 50 * n == bytes.size()) return read_binary_stl(bytes, options);
+  }
+  std::string_view text = bytes;
+  while (!text.empty() && (is_space(text[0]) || text[0] == '\n')) text.remove_prefix(1);
+  if (text.substr(0, 5) == "solid") return read_ascii_stl(bytes, options);
+  return read_binary_stl(bytes, options);
+}
+
+}  // namespace remesh::io
