@@ -1,0 +1,230 @@
+/// Watching one job: its document, every statistics row (GET /stats first, then the event stream
+/// from the last row held, so a reload misses nothing), the progress line, the charts, the table
+/// and the download buttons.
+
+import * as api from './api.js';
+import { IterationChart } from './charts.js';
+
+const $ = (id) => document.getElementById(id);
+export const FINAL = new Set(['succeeded', 'failed', 'cancelled']);
+const RESULT_FORMATS = { remeshed: ['obj', 'glb', 'ply', 'off', 'stl'], dual: ['obj', 'glb', 'ply', 'off', 'xyz'] };
+const TABLE = [
+  ['iteration', (v) => v], ['vertices', int], ['edges', int], ['mean', num], ['deviation', num],
+  ['regular_percent', (v) => fixed(v, 1)], ['small', int], ['big', int],
+  ['inside_fraction', (v) => fixed(100 * v, 1)], ['splits', int], ['collapses', int], ['flips', int],
+  ['seconds', (v) => fixed(v, 3)], ['max_projection_distance', num]];
+
+function int(v) { return Number.isFinite(v) ? v.toLocaleString('en-US') : '–'; }
+function num(v) { return Number.isFinite(v) ? String(+v.toPrecision(5)) : '–'; }
+function fixed(v, d) { return Number.isFinite(v) ? v.toFixed(d) : '–'; }
+
+export class JobView {
+  /// hooks: on_job(job) after every document refresh, on_end(job) once when the job is final.
+  constructor(hooks) {
+    this.hooks = hooks;
+    this.job = null;
+    this.rows = [];
+    this.source = null;
+    this.retry = null;
+    this.generation = 0;
+    const params = () => this.job?.params || {};
+    this.charts = [
+      new IterationChart($('chart-length'), [
+        { key: (r) => r.mean, label: 'mean', color: '--accent' },
+        { key: (r) => r.deviation, label: 'deviation', color: '--warn' }],
+      { marks: () => [{ value: params().emin, label: 'e_min', color: '--short' },
+        { value: params().emax, label: 'e_max', color: '--long' }] }),
+      new IterationChart($('chart-out'), [
+        { key: (r) => r.small + r.big, label: 'outside', color: '--err' },
+        { key: (r) => r.small, label: 'small', color: '--ok' },
+        { key: (r) => r.big, label: 'big', color: '--short' }]),
+      new IterationChart($('chart-vertices'), [{ key: (r) => r.vertices, label: 'vertices', color: '--accent' }],
+        { min_zero: false }),
+      new IterationChart($('chart-regular'), [{ key: (r) => r.regular_percent, label: 'regular %', color: '--ok' }],
+        { percent: true }),
+      new IterationChart($('chart-seconds'), [{ key: (r) => r.seconds, label: 'seconds', color: '--accent', bars: true }]),
+    ];
+    $('cancel').addEventListener('click', () => this.cancel());
+  }
+
+  /// Starts watching job `id` (stops watching the previous one).
+  async watch(id) {
+    this.stop();
+    const generation = ++this.generation;
+    this.rows = [];
+    $('rows').tBodies[0].replaceChildren();
+    this.draw_rows();
+    $('job-id').textContent = id;
+    $('job-error').textContent = '';
+    try {
+      this.set_job(await api.get_job(id));
+      const rows = await api.get_stats(id);
+      if (generation !== this.generation) return;
+      this.add_rows(rows);
+    } catch (e) {
+      if (generation !== this.generation) return;
+      if (e.status === 404) { this.show_error(`Job ${id} does not exist (it may have expired).`); return; }
+      this.show_error(e.message);
+      if (e.status !== 401) this.retry = setTimeout(() => this.watch(id), 3000);
+      return;
+    }
+    if (FINAL.has(this.job.state)) { this.finish(); return; }
+    this.open_stream(generation);
+  }
+
+  open_stream(generation) {
+    const id = this.job.id;
+    const last = this.rows.length ? this.rows[this.rows.length - 1].iteration : 0;
+    const es = api.events(id, last);
+    this.source = es;
+    es.addEventListener('iteration', (e) => this.add_rows([JSON.parse(e.data)]));
+    es.addEventListener('state', (e) => {
+      const { state } = JSON.parse(e.data);
+      if (this.job && state) { this.job.state = state; this.render_head(); }
+      this.refresh(generation);
+    });
+    es.addEventListener('end', () => { es.close(); this.refresh(generation, true); });
+    es.onerror = () => {
+      // EventSource retries by itself (with Last-Event-ID) unless the server refused the stream.
+      if (es.readyState !== EventSource.CLOSED || generation !== this.generation) return;
+      this.source = null;
+      this.retry = setTimeout(() => this.resume(generation), 2000);
+    };
+  }
+
+  /// After a refused or broken stream: catch up through /stats, then stream again.
+  async resume(generation) {
+    if (generation !== this.generation || !this.job) return;
+    try {
+      this.set_job(await api.get_job(this.job.id));
+      this.add_rows(await api.get_stats(this.job.id));
+      if (FINAL.has(this.job.state)) this.finish(); else this.open_stream(generation);
+    } catch (e) {
+      this.show_error(`Lost the connection to the job: ${e.message}. Retrying…`);
+      if (e.status !== 401 && e.status !== 404) this.retry = setTimeout(() => this.resume(generation), 3000);
+    }
+  }
+
+  async refresh(generation, ended = false) {
+    try {
+      const job = await api.get_job(this.job.id);
+      if (generation !== this.generation) return;
+      this.set_job(job);
+      if (ended || FINAL.has(job.state)) {
+        this.add_rows(await api.get_stats(job.id));  // rows sent just before the end, if any raced
+        this.finish();
+      }
+    } catch (e) { this.show_error(e.message); }
+  }
+
+  stop() {
+    ++this.generation;
+    if (this.source) this.source.close();
+    this.source = null;
+    clearTimeout(this.retry);
+  }
+
+  finish() {
+    if (this.source) { this.source.close(); this.source = null; }
+    if (this.ended_id === this.job.id) return;
+    this.ended_id = this.job.id;
+    this.hooks.on_end(this.job);
+  }
+
+  set_job(job) {
+    this.job = job;
+    this.render_head();
+    this.render_downloads();
+    this.hooks.on_job(job);
+    for (const c of this.charts) c.schedule();
+  }
+
+  add_rows(rows) {
+    let last = this.rows.length ? this.rows[this.rows.length - 1].iteration : -Infinity;
+    const body = $('rows').tBodies[0];
+    const fresh = [];
+    for (const row of rows) {
+      if (!(row.iteration > last)) continue;  // a row seen already (reconnect overlap)
+      last = row.iteration;
+      this.rows.push(row);
+      fresh.push(row);
+      const tr = document.createElement('tr');
+      for (const [key, f] of TABLE) {
+        const td = document.createElement('td');
+        td.textContent = f(row[key]);
+        tr.append(td);
+      }
+      body.append(tr);
+    }
+    if (!fresh.length) return;
+    const wrap = body.closest('.tablewrap');
+    if (wrap.scrollHeight - wrap.scrollTop - wrap.clientHeight < 60) wrap.scrollTop = wrap.scrollHeight;
+    this.draw_rows();
+    this.render_head();
+  }
+
+  draw_rows() { for (const c of this.charts) c.set_rows(this.rows); }
+
+  render_head() {
+    const job = this.job;
+    const state = $('job-state');
+    state.textContent = job.state;
+    state.className = `state ${job.state}`;
+    const total = job.params?.iterations || job.progress?.iterations || 0;
+    const done = Math.max(job.progress?.iteration || 0, this.rows.length ? this.rows[this.rows.length - 1].iteration : 0);
+    const bar = $('progress');
+    bar.max = Math.max(total, 1);
+    bar.value = job.state === 'succeeded' ? bar.max : Math.min(done, bar.max);
+    let text = `iteration ${done} of ${total}`;
+    if (job.state === 'succeeded' && done < total) text += ' (converged early)';
+    if (job.outcome) text += ` · ${typeof job.outcome === 'string' ? job.outcome : JSON.stringify(job.outcome)}`;
+    const secs = this.rows.reduce((s, r) => s + (r.seconds || 0), 0);
+    if (secs) text += ` · ${secs.toFixed(1)} s`;
+    $('progress-text').textContent = text;
+    $('cancel').disabled = !(job.state === 'queued' || job.state === 'running');
+    if (job.error) this.show_error(typeof job.error === 'string' ? job.error : job.error.detail || JSON.stringify(job.error));
+  }
+
+  render_downloads() {
+    const job = this.job;
+    const box = $('downloads');
+    box.replaceChildren();
+    const base = (job.input?.filename || 'mesh').replace(/\.[^.]*$/, '');
+    const group = (label, items) => {
+      const g = document.createElement('div');
+      g.className = 'grp';
+      g.setAttribute('role', 'group');
+      g.setAttribute('aria-label', `Download ${label}`);
+      const s = document.createElement('span');
+      s.textContent = label;
+      g.append(s);
+      for (const [text, url, name] of items) {
+        const b = document.createElement('button');
+        b.type = 'button';
+        b.textContent = text;
+        b.title = url;
+        b.dataset.url = url;
+        b.setAttribute('aria-label', `Download ${label} as ${text}`);
+        b.addEventListener('click', () => api.download(url, name).catch((e) => this.show_error(e.message)));
+        g.append(b);
+      }
+      box.append(g);
+    };
+    if (job.state === 'succeeded') {
+      for (const mesh of ['remeshed', 'dual'])
+        group(mesh, RESULT_FORMATS[mesh].map((f) => [f, api.result_url(job.id, mesh, f), `${base}_${mesh}.${f}`]));
+    }
+    group('statistics', [['csv', api.stats_csv_url(job.id), `${base}_stats.csv`]]);
+  }
+
+  async cancel() {
+    if (!this.job) return;
+    $('cancel').disabled = true;
+    try {
+      await api.delete_job(this.job.id);
+      this.refresh(this.generation);
+    } catch (e) { this.show_error(`Cancel failed: ${e.message}`); }
+  }
+
+  show_error(text) { $('job-error').textContent = text; }
+}

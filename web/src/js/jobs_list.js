@@ -1,0 +1,79 @@
+/// The recent-jobs list (GET /jobs, newest first): state, file, progress and a link that watches
+/// the job here (#job=<id>), so a job started with curl can be followed in the page.
+
+import * as api from './api.js';
+
+const $ = (id) => document.getElementById(id);
+
+export class JobsList {
+  constructor() {
+    this.timer = null;
+    this.current = '';
+    $('jobs-refresh').addEventListener('click', () => this.refresh());
+    document.addEventListener('visibilitychange', () => { if (!document.hidden) this.refresh(); });
+  }
+
+  set_current(id) {
+    this.current = id;
+    for (const li of $('jobs').children) li.classList.toggle('current', li.dataset.id === id);
+  }
+
+  /// Fetches the list now and again every few seconds while anything is active.
+  async refresh() {
+    clearTimeout(this.timer);
+    let active = false;
+    try {
+      const body = await api.list_jobs(20);
+      const jobs = body.jobs || [];
+      active = jobs.some((j) => ['queued', 'running', 'cancelling'].includes(j.state));
+      this.render(jobs, body.total ?? jobs.length);
+    } catch (e) {
+      $('jobs').replaceChildren(Object.assign(document.createElement('li'), { className: 'err', textContent: e.message }));
+    }
+    if (!document.hidden) this.timer = setTimeout(() => this.refresh(), active ? 3000 : 15000);
+  }
+
+  render(jobs, total) {
+    const ol = $('jobs');
+    ol.replaceChildren();
+    if (!jobs.length) {
+      ol.append(Object.assign(document.createElement('li'), { className: 'muted', textContent: 'No jobs yet.' }));
+      return;
+    }
+    for (const job of jobs) {
+      const li = document.createElement('li');
+      li.dataset.id = job.id;
+      li.classList.toggle('current', job.id === this.current);
+      const state = Object.assign(document.createElement('span'), { className: `state ${job.state}`, textContent: job.state });
+      const a = document.createElement('a');
+      a.href = `#job=${encodeURIComponent(job.id)}`;
+      a.className = 'name';
+      a.textContent = job.input?.filename || job.id;
+      a.title = `Watch job ${job.id}`;
+      const events = document.createElement('a');
+      events.href = `${api.BASE}/jobs/${encodeURIComponent(job.id)}`;
+      events.textContent = 'json';
+      events.title = 'The job document';
+      events.target = '_blank';
+      const meta = document.createElement('span');
+      meta.className = 'meta';
+      const p = job.progress || {};
+      const v = job.input?.summary?.vertices;
+      meta.textContent = [job.id.slice(0, 8), when(job.created_at),
+        p.iterations ? `${p.iteration ?? 0}/${p.iterations} it` : '', v ? `${v.toLocaleString()} v` : '']
+        .filter(Boolean).join(' · ');
+      li.append(state, a, events, meta);
+      ol.append(li);
+    }
+    if (total > jobs.length)
+      ol.append(Object.assign(document.createElement('li'), { className: 'muted', textContent: `${total - jobs.length} older not shown` }));
+  }
+}
+
+function when(iso) {
+  if (!iso) return '';
+  const d = new Date(typeof iso === 'number' && iso < 1e12 ? iso * 1000 : iso);
+  if (Number.isNaN(+d)) return String(iso);
+  const same_day = d.toDateString() === new Date().toDateString();
+  return same_day ? d.toLocaleTimeString([], { hour12: false }) : d.toLocaleString([], { hour12: false });
+}
