@@ -8,6 +8,7 @@ import { parse_glb } from './glb.js';
 import { JobView } from './job_view.js';
 import { JobsList } from './jobs_list.js';
 import { fmt } from './charts.js';
+import { triangle_edges, edge_lengths, length_stats } from './edges.js';
 
 const $ = (id) => document.getElementById(id);
 const state = { file: null, input_of: null, viewer: null, loading: new Map() };
@@ -95,8 +96,10 @@ async function choose_file(file) {
   status(`reading ${file.name}…`);
   try {
     const mesh = await read_preview(file);
+    await state.viewer_ready;
     if (state.file !== file) return;
-    const stats = state.viewer?.set_mesh('input', mesh, { label: 'input (local preview)' });
+    const stats = state.viewer ? state.viewer.set_mesh('input', mesh, { label: 'input (local preview)' })
+      : length_stats(edge_lengths(mesh.positions, triangle_edges(mesh.triangles, mesh.positions.length / 3)));
     state.viewer?.show('input');
     show_summary({ vertices: mesh.positions.length / 3, faces: mesh.faces,
       edge_length: stats ? { mean: stats.mean } : undefined }, 'local preview; the server summary follows the upload');
@@ -320,7 +323,8 @@ $('params').addEventListener('submit', submit);
 window.addEventListener('hashchange', () => { const id = job_id_from_hash(); if (id) watch(id); });
 poll_health();
 jobs.refresh();
-await init_viewer();
+state.viewer_ready = init_viewer();
+await state.viewer_ready;
 const initial = job_id_from_hash();
 if (initial) watch(initial);
 window.__remeshd = { state, view, jobs };  // for the browser test and for debugging in the console
