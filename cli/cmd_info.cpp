@@ -8,7 +8,7 @@
 #include "args.h"
 #include "commands.h"
 #include "io/summary.h"
-#include "json_out.h"
+#include "api/json_codec.h"
 
 namespace remesh::cli {
 namespace {
@@ -63,6 +63,21 @@ void print_summary(std::ostream& out, const std::string& file, const LoadedMesh&
   }
 }
 
+/// The API's summary JSON (same field names as remeshd), plus the file, its format and the
+/// per-component details the text output shows.
+std::string info_json(const std::string& file, const LoadedMesh& loaded, const MeshSummary& s) {
+  nlohmann::json j = summary_json(s, loaded.repairs);
+  j["file"] = file;
+  j["format"] = std::string(format_name(loaded.format));
+  nlohmann::json components = nlohmann::json::array();
+  for (const auto& c : s.per_component)
+    components.push_back({{"vertices", c.vertices}, {"faces", c.faces}, {"edges", c.edges},
+                          {"boundary_loops", c.boundary_loops}, {"euler", c.euler}, {"genus", c.genus},
+                          {"closed", c.closed}});
+  j["per_component"] = components;
+  return j.dump(2);
+}
+
 }  // namespace
 
 int run_info(const std::vector<std::string>& args) {
@@ -82,7 +97,7 @@ int run_info(const std::vector<std::string>& args) {
   const LoadedMesh loaded = read_mesh_file(file, options);
   const MeshSummary summary = summarize(loaded.mesh);
   if (a.has("json"))
-    std::cout << info_json(file, loaded.format, summary, loaded.repairs) << "\n";
+    std::cout << info_json(file, loaded, summary) << "\n";
   else
     print_summary(std::cout, file, loaded, summary);
   return 0;

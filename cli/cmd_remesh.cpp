@@ -14,7 +14,7 @@
 #include "dual/trivalent_dual.h"
 #include "interrupt.h"
 #include "io/summary.h"
-#include "json_out.h"
+#include "api/json_codec.h"
 #include "progress.h"
 #include "remesh/equalize.h"
 #include "remesh/reference_surface.h"
@@ -165,7 +165,7 @@ int run_remesh(const std::vector<std::string>& args) {
   if (job.dual_out) write_mesh_file(to_soup(trivalent_dual(mesh, &*reference)), *job.dual_out);
   if (job.stats_out) {
     const bool json = job.stats_out->size() > 5 && job.stats_out->ends_with(".json");
-    write_text_file(*job.stats_out, json ? stats_json(rows) : stats_csv(rows));
+    write_text_file(*job.stats_out, json ? nlohmann::json(rows).dump(2) + "\n" : stats_to_csv(rows));
   }
   if (!job.quiet) print_final(mesh, job, result);
   if (result.outcome == Outcome::Cancelled) {
