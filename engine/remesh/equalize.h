@@ -33,6 +33,9 @@ struct IterationStats {
   std::size_t splits = 0, collapses = 0, flips = 0;
   double seconds = 0;                  ///< wall time of this iteration
   double max_projection_distance = 0;  ///< largest distance a vertex moved in the projection
+  /// Local fixes made by the interval cleanup (Params::cleanup) in this iteration; they are also
+  /// counted in splits, collapses and flips. Non-zero only in the last iteration.
+  std::size_t cleanup_fixes = 0;
 };
 
 using OnIteration = std::function<void(const IterationStats&)>;

@@ -23,6 +23,17 @@ class ReferenceSurface {
   /// Closest point on the reference surface to `p`. `normal_hint` may be zero (no preference).
   Vec3 closest_point(const Vec3& p, const Vec3& normal_hint = Vec3(0, 0, 0)) const;
 
+  /// Closest point to `p` on the boundary curves of the reference (the boundary edges incident to
+  /// the nearest reference vertices). Falls back to closest_point(p) when none is near.
+  Vec3 closest_boundary_point(const Vec3& p) const;
+
+  /// True when the reference has at least one boundary edge.
+  bool has_boundary() const;
+
+  /// Reference vertex and triangle counts.
+  std::size_t n_vertices() const;
+  std::size_t n_triangles() const;
+
  private:
   struct Impl;
   std::unique_ptr<Impl> impl_;

@@ -1,0 +1,40 @@
+#pragma once
+/// \file bench_common.h
+/// Helpers of the benchmark programs: a small mesh loader (OpenMesh I/O, until engine/io is linked),
+/// scaling, topology counts and the symmetric Hausdorff distance by dense sampling.
+
+#include <cstddef>
+#include <string>
+
+#include "core/mesh.h"
+
+namespace remesh::bench {
+
+/// Reads OFF/OBJ/PLY/STL with OpenMesh. Throws std::runtime_error naming the file on failure.
+TriMesh load_mesh(const std::string& path);
+
+/// Writes an OFF file with 17 significant digits. Throws std::runtime_error on failure.
+void write_off(const TriMesh& mesh, const std::string& path);
+
+/// Scales the mesh about the origin so that its mean edge length becomes `mean_edge`. Returns the factor.
+double scale_to_mean_edge(TriMesh& mesh, double mean_edge);
+
+struct Topology {
+  long euler = 0;
+  std::size_t boundary_loops = 0, components = 0;
+};
+Topology topology_of(const TriMesh& mesh);
+
+/// Length of the bounding-box diagonal.
+double bbox_diagonal(const TriMesh& mesh);
+
+/// Symmetric Hausdorff distance between a and b, estimated by sampling: every vertex plus about
+/// `samples` points spread over the faces by area (barycentric grid per face), each measured
+/// against a ReferenceSurface (kd-tree, 30 nearest vertices) of the other mesh; the larger of the
+/// two one-sided maxima.
+double hausdorff_distance(const TriMesh& a, const TriMesh& b, std::size_t samples, unsigned threads);
+
+/// Peak resident set size of this process so far (VmHWM), in MiB.
+double peak_rss_mib();
+
+}  // namespace remesh::bench

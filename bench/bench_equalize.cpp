@@ -1,0 +1,239 @@
+/// \file bench_equalize.cpp
+/// Reproduces the thesis' Table 4.2 setup on any mesh, and compares with CGAL.
+///
+///   bench_equalize MESH... [--setup refine|simplify|both] [--iterations N] [--no-cgal]
+///                  [--threads T] [--samples N] [--rows-every K] [--no-cleanup] [--keep DIR]
+///
+/// refine:   scale the mesh so its mean edge is 2.25, remesh to [1.2, 1.8] (Table 4.2)
+/// simplify: scale to mean edge 0.75, remesh to [1.2, 1.8] (Table 4.1)
+/// k=2, pr=0, f=0.5, up to N=100 iterations (stops early if every edge is inside). Each remesher
+/// runs in a forked child that reads the scaled input from a temporary OFF file, so the peak memory
+/// (ru_maxrss of the child) and the time (of the remeshing call alone) compare like for like.
+/// CGAL: isotropic_remeshing, target (e_min + e_max) / 2, 10 iterations, nothing protected.
+
+#include <malloc.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "bench_common.h"
+#include "remesh/equalize.h"
+#ifdef REMESH_BENCH_HAS_CGAL
+#include "cgal_isotropic.h"
+#endif
+
+namespace fs = std::filesystem;
+using namespace remesh;
+
+namespace {
+
+struct Options {
+  std::vector<std::string> meshes;
+  bool refine = true, simplify = false, cgal = true, cleanup = true;
+  int iterations = 100, rows_every = 5;
+  unsigned threads = 0;
+  std::size_t samples = 400000;
+  std::string keep_dir;
+};
+
+constexpr double kEmin = 1.2, kEmax = 1.8;
+
+[[noreturn]] void usage(const std::string& error) {
+  std::fprintf(stderr,
+               "bench_equalize: %s\nusage: bench_equalize MESH... [--setup refine|simplify|both] [--iterations N] "
+               "[--no-cgal] [--threads T] [--samples N] [--rows-every K] [--no-cleanup] [--keep DIR]\n",
+               error.c_str());
+  std::exit(1);
+}
+
+Options parse(int argc, char** argv) {
+  Options o;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    auto value = [&]() -> std::string {
+      if (i + 1 >= argc) usage("missing value for " + a);
+      return argv[++i];
+    };
+    try {
+      if (a == "--setup") {
+        const std::string s = value();
+        if (s == "refine") o.refine = true, o.simplify = false;
+        else if (s == "simplify") o.refine = false, o.simplify = true;
+        else if (s == "both") o.refine = o.simplify = true;
+        else usage("--setup must be refine, simplify or both");
+      } else if (a == "--iterations") o.iterations = std::stoi(value());
+      else if (a == "--threads") o.threads = static_cast<unsigned>(std::stoul(value()));
+      else if (a == "--samples") o.samples = std::stoul(value());
+      else if (a == "--rows-every") o.rows_every = std::max(1, std::stoi(value()));
+      else if (a == "--no-cgal") o.cgal = false;
+      else if (a == "--no-cleanup") o.cleanup = false;
+      else if (a == "--keep") o.keep_dir = value();
+      else if (!a.empty() && a[0] == '-') usage("unknown option " + a);
+      else o.meshes.push_back(a);
+    } catch (const std::logic_error&) {
+      usage("bad value for " + a);
+    }
+  }
+  if (o.meshes.empty()) usage("no mesh given");
+  return o;
+}
+
+struct ChildResult {
+  bool ok = false;
+  double seconds = 0, peak_mib = 0;
+  int iterations = 0;
+  std::string outcome;
+};
+
+/// Runs `job(result_file)` in a forked child; returns its timing line and peak memory.
+template <class Job>
+ChildResult run_in_child(const std::string& result_file, Job job) {
+  std::fflush(stdout);
+  malloc_trim(0);
+  const pid_t pid = fork();
+  if (pid < 0) throw std::runtime_error("fork failed");
+  if (pid == 0) {
+    int code = 0;
+    try {
+      job(result_file);
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "bench_equalize: child failed: %s\n", e.what());
+      code = 3;
+    }
+    std::fflush(stdout);
+    std::fflush(stderr);
+    _exit(code);
+  }
+  int status = 0;
+  struct rusage usage {};
+  wait4(pid, &status, 0, &usage);
+  ChildResult r;
+  r.peak_mib = static_cast<double>(usage.ru_maxrss) / 1024.0;
+  std::ifstream in(result_file + ".time");
+  r.ok = WIFEXITED(status) && WEXITSTATUS(status) == 0 && static_cast<bool>(in >> r.seconds >> r.iterations >> r.outcome);
+  return r;
+}
+
+void print_row(const IterationStats& s) {
+  std::printf("%4d %9zu %9zu %7.4f %7.4f %8.2f %7zu %7zu %8.3f %7zu %7zu %7zu %7.3f %8.4f\n", s.iteration,
+              s.vertices, s.edges, s.mean, s.deviation, s.regular_percent, s.small, s.big, 100 * s.inside_fraction,
+              s.splits, s.collapses, s.flips, s.seconds, s.max_projection_distance);
+}
+
+const char* outcome_name(Outcome o) {
+  return o == Outcome::Converged ? "converged" : o == Outcome::Cancelled ? "cancelled" : "completed";
+}
+
+/// The quality row printed for each remesher.
+void print_quality(const char* who, const TriMesh& input, const TriMesh& output, const bench::Topology& topo_in,
+                   const ChildResult& r, const Options& o) {
+  const IterationStats s = measure(output, kEmin, kEmax, o.threads);
+  const bench::Topology t = bench::topology_of(output);
+  const double h = bench::hausdorff_distance(input, output, o.samples, o.threads) / bench::bbox_diagonal(input);
+  std::printf("%-5s: inside %.3f %% (small %zu, big %zu), regular %.2f %%, mean %.4f, dev %.4f, V %zu, F %zu, "
+              "Hausdorff %.4f %% of bbox diagonal, %d it (%s), %.4f s/it, total %.3f s, peak %.1f MiB, "
+              "topology %s (euler %ld, boundary loops %zu, components %zu)\n",
+              who, 100 * s.inside_fraction, s.small, s.big, s.regular_percent, s.mean, s.deviation, output.n_vertices(),
+              output.n_faces(), 100 * h, r.iterations, r.outcome.c_str(),
+              r.iterations ? r.seconds / r.iterations : 0.0, r.seconds, r.peak_mib,
+              (t.euler == topo_in.euler && t.boundary_loops == topo_in.boundary_loops &&
+               t.components == topo_in.components)
+                  ? "preserved"
+                  : "CHANGED",
+              t.euler, t.boundary_loops, t.components);
+}
+
+void run_setup(const std::string& path, const char* setup, double mean_edge, const Options& o, const fs::path& dir) {
+  const std::string name = fs::path(path).filename().string() + "_" + setup;
+  const std::string scaled = (dir / (name + "_in.off")).string();
+  bench::Topology topo_in;
+  {
+    TriMesh mesh = bench::load_mesh(path);
+    const double factor = bench::scale_to_mean_edge(mesh, mean_edge);
+    topo_in = bench::topology_of(mesh);
+    bench::write_off(mesh, scaled);
+    std::printf("\n== %s, setup %s: scaled by %.6g to mean edge %.2f; target [%.1f, %.1f], k=2, pr=0, f=0.5, up to %d "
+                "iterations%s; input V %zu F %zu (euler %ld, boundary loops %zu, components %zu)\n",
+                path.c_str(), setup, factor, mean_edge, kEmin, kEmax, o.iterations, o.cleanup ? "" : ", no cleanup",
+                mesh.n_vertices(), mesh.n_faces(), topo_in.euler, topo_in.boundary_loops, topo_in.components);
+  }
+  std::printf("  it  vertices     edges    mean     dev regular%%   small     big  inside%%  splits  collap   flips    "
+              "s/it  maxproj\n");
+  const std::string ours_out = (dir / (name + "_ours.off")).string();
+  const ChildResult ours = run_in_child(ours_out, [&](const std::string& out) {
+    TriMesh mesh = bench::load_mesh(scaled);
+    Params p;
+    p.e_min = kEmin;
+    p.e_max = kEmax;
+    p.iterations = o.iterations;
+    p.threads = o.threads;
+    p.cleanup = o.cleanup;
+    IterationStats last;
+    const Result r = equalize(mesh, p, [&](const IterationStats& s) {
+      if (s.iteration % o.rows_every == 0 || s.iteration == 1) print_row(s);
+      last = s;
+    });
+    if (last.iteration % o.rows_every != 0 && last.iteration != 1) print_row(last);
+    if (last.cleanup_fixes) std::printf("  (last row includes %zu interval-cleanup fixes)\n", last.cleanup_fixes);
+    bench::write_off(mesh, out);
+    std::ofstream(out + ".time") << r.seconds << ' ' << r.iterations_done << ' ' << outcome_name(r.outcome) << '\n';
+  });
+  TriMesh input = bench::load_mesh(scaled);
+  if (!ours.ok) {
+    std::printf("ours : FAILED\n");
+  } else {
+    print_quality("ours", input, bench::load_mesh(ours_out), topo_in, ours, o);
+  }
+#ifdef REMESH_BENCH_HAS_CGAL
+  if (o.cgal) {
+    const std::string cgal_out = (dir / (name + "_cgal.off")).string();
+    const ChildResult cgal = run_in_child(cgal_out, [&](const std::string& out) {
+      const double seconds = bench::run_cgal_isotropic(scaled, out, 0.5 * (kEmin + kEmax), 10);
+      std::ofstream(out + ".time") << seconds << " 10 completed\n";
+    });
+    if (!cgal.ok) {
+      std::printf("cgal : FAILED\n");
+    } else {
+      print_quality("cgal", input, bench::load_mesh(cgal_out), topo_in, cgal, o);
+      if (ours.ok)
+        std::printf("ratio ours/cgal: time %.2fx, peak memory %.2fx\n", ours.seconds / cgal.seconds,
+                    ours.peak_mib / cgal.peak_mib);
+    }
+  }
+#endif
+  std::fflush(stdout);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const Options o = parse(argc, argv);
+  const fs::path dir = o.keep_dir.empty() ? fs::temp_directory_path() / ("bench_equalize." + std::to_string(getpid()))
+                                          : fs::path(o.keep_dir);
+  fs::create_directories(dir);
+  std::printf("bench_equalize: Hausdorff = max of the two one-sided maxima over every vertex plus ~%zu barycentric "
+              "samples per mesh, each measured to the other mesh's surface (kd-tree, 30 nearest vertices, their "
+              "triangles); time = the remeshing call alone; peak = ru_maxrss of the forked child (load + remesh + "
+              "write); threads %u (0 = all cores; CGAL runs on one)\n",
+              o.samples, o.threads);
+  int failures = 0;
+  for (const auto& path : o.meshes) {
+    try {
+      if (o.refine) run_setup(path, "refine", 2.25, o, dir);
+      if (o.simplify) run_setup(path, "simplify", 0.75, o, dir);
+    } catch (const std::exception& e) {
+      std::printf("%s: error: %s\n", path.c_str(), e.what());
+      ++failures;
+    }
+  }
+  if (o.keep_dir.empty()) fs::remove_all(dir);
+  return failures ? 2 : 0;
+}

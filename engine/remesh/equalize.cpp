@@ -1,0 +1,130 @@
+#include "remesh/equalize.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <memory>
+#include <string>
+
+#include "core/errors.h"
+#include "remesh/fold_guard.h"
+#include "remesh/interval_cleanup.h"
+#include "remesh/low_pass_filter.h"
+#include "remesh/priority_list.h"
+#include "remesh/projection.h"
+#include "remesh/reference_surface.h"
+#include "remesh/statistics.h"
+#include "remesh/stellar_operations.h"
+#include "remesh/valence_flips.h"
+
+namespace remesh {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+/// Flip sweeps per iteration: the thesis does one; further sweeps catch the flips the first one
+/// enabled and raise regularity for little time.
+constexpr int kFlipSweeps = 3;
+
+void check_preconditions(const TriMesh& mesh, const Params& params) {
+  if (auto errors = check(params); !errors.empty()) throw ParamsError(std::move(errors));
+  if (mesh.n_faces() == 0) throw MeshError("the mesh has no faces");
+  const std::size_t estimate = estimate_output_faces(mesh, params);
+  if (params.max_output_faces > 0 && estimate > params.max_output_faces)
+    throw LimitError("estimated output of " + std::to_string(estimate) + " faces exceeds the limit of " +
+                     std::to_string(params.max_output_faces) + " faces (e_max too small for this mesh)");
+}
+
+}  // namespace
+
+std::size_t estimate_output_faces(const TriMesh& mesh, const Params& params) {
+  const double m = 0.5 * (params.e_min + params.e_max);
+  if (!(m > 0) || !std::isfinite(m)) return 0;
+  const double faces = surface_area(mesh) / (std::sqrt(3.0) / 4.0 * m * m);
+  if (!std::isfinite(faces) || faces > 1e18) return static_cast<std::size_t>(1e18);
+  return static_cast<std::size_t>(std::ceil(faces));
+}
+
+Result equalize(TriMesh& mesh, const Params& params, const OnIteration& on_iteration, std::stop_token stop) {
+  check_preconditions(mesh, params);
+  const auto start = Clock::now();
+  const unsigned threads = params.threads;
+  const double m = 0.5 * (params.e_min + params.e_max);
+  const double sigma = 0.5 * (params.e_max - params.e_min);
+  mesh.garbage_collection();
+  auto reference = std::make_unique<ReferenceSurface>(mesh);
+
+  Result result;
+  for (int i = 1; i <= params.iterations; ++i) {
+    if (stop.stop_requested()) {
+      result.outcome = Outcome::Cancelled;
+      break;
+    }
+    const auto iteration_start = Clock::now();
+    IterationStats counters;
+    if (params.relax_every > 0 && i % params.relax_every == 0) reference = std::make_unique<ReferenceSurface>(mesh);
+
+    // Algorithms 2 and 3: stellar operations on the priority list.
+    const double m_i = std::min(2.0 * mean_edge_length(mesh, threads), m);
+    const std::vector<unsigned> list = make_priority_list(mesh, m_i, sigma, threads);
+    const StellarCounts stellar = stellar_operations(mesh, list, m_i, sigma);
+    mesh.garbage_collection();
+    counters.splits = stellar.splits;
+    counters.collapses = stellar.collapses;
+    if (stop.stop_requested()) {
+      result.outcome = Outcome::Cancelled;
+      break;
+    }
+
+    // Algorithm 4: valence-improving flips.
+    counters.flips = valence_flips(mesh, params.flip_factor, kFlipSweeps);
+    if (stop.stop_requested()) {
+      result.outcome = Outcome::Cancelled;
+      break;
+    }
+
+    // Algorithm 5 then 6: filter and projection, guarded against folds as one move.
+    const std::vector<Vec3> before = snapshot_points(mesh);
+    low_pass_filter(mesh, params.rings, threads);
+    if (stop.stop_requested()) {
+      undo_folds(mesh, before, threads);
+      result.outcome = Outcome::Cancelled;
+      break;
+    }
+    counters.max_projection_distance = project_onto_reference(mesh, *reference, threads);
+    undo_folds(mesh, before, threads);
+
+    // Not in the thesis: the post-process its conclusion asks for, in the last iteration.
+    if (params.cleanup && i == params.iterations && !stop.stop_requested()) {
+      const CleanupCounts c = interval_cleanup(mesh, *reference, params.e_min, params.e_max, params.flip_factor);
+      counters.cleanup_fixes = c.flips + c.collapses + c.splits + c.relocations;
+      counters.splits += c.splits;
+      counters.collapses += c.collapses;
+      counters.flips += c.flips;
+    }
+
+    IterationStats row = measure(mesh, params.e_min, params.e_max, threads);
+    row.iteration = i;
+    row.splits = counters.splits;
+    row.collapses = counters.collapses;
+    row.flips = counters.flips;
+    row.cleanup_fixes = counters.cleanup_fixes;
+    row.max_projection_distance = counters.max_projection_distance;
+    row.seconds = seconds_since(iteration_start);
+    result.iterations_done = i;
+    if (on_iteration) on_iteration(row);
+    if (!params.run_all_iterations && row.small == 0 && row.big == 0) {
+      result.outcome = Outcome::Converged;
+      break;
+    }
+  }
+  result.seconds = seconds_since(start);
+  return result;
+}
+
+}  // namespace remesh

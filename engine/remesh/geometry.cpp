@@ -1,0 +1,115 @@
+#include "remesh/geometry.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "core/parallel.h"
+
+namespace remesh::geom {
+
+double min_angle(const Vec3& a, const Vec3& b, const Vec3& c) {
+  const double la = (b - c).sqrnorm(), lb = (c - a).sqrnorm(), lc = (a - b).sqrnorm();
+  const double area2 = cross_normal(a, b, c).norm();
+  if (!(area2 > 0) || la == 0 || lb == 0 || lc == 0) return 0;
+  // The smallest angle is opposite the shortest side: sin(angle) = area2 / (|x| |y|).
+  double angle;
+  if (la <= lb && la <= lc) {
+    angle = std::atan2(area2, (b - a) | (c - a));
+  } else if (lb <= la && lb <= lc) {
+    angle = std::atan2(area2, (a - b) | (c - b));
+  } else {
+    angle = std::atan2(area2, (a - c) | (b - c));
+  }
+  return angle;
+}
+
+Vec3 closest_point_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
+  const Vec3 ab = b - a, ac = c - a, ap = p - a;
+  const double d1 = ab | ap, d2 = ac | ap;
+  if (d1 <= 0 && d2 <= 0) return a;
+  const Vec3 bp = p - b;
+  const double d3 = ab | bp, d4 = ac | bp;
+  if (d3 >= 0 && d4 <= d3) return b;
+  const double vc = d1 * d4 - d3 * d2;
+  if (vc <= 0 && d1 >= 0 && d3 <= 0) return a + ab * (d1 / (d1 - d3));
+  const Vec3 cp = p - c;
+  const double d5 = ab | cp, d6 = ac | cp;
+  if (d6 >= 0 && d5 <= d6) return c;
+  const double vb = d5 * d2 - d1 * d6;
+  if (vb <= 0 && d2 >= 0 && d6 <= 0) return a + ac * (d2 / (d2 - d6));
+  const double va = d3 * d6 - d5 * d4;
+  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0)
+    return b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6)));
+  const double denom = va + vb + vc;
+  if (!(denom > 0)) return a;  // degenerate triangle
+  const double v = vb / denom, w = vc / denom;
+  return a + ab * v + ac * w;
+}
+
+Vec3 closest_point_on_segment(const Vec3& p, const Vec3& a, const Vec3& b) {
+  const Vec3 ab = b - a;
+  const double l2 = ab.sqrnorm();
+  if (!(l2 > 0)) return a;
+  const double t = std::clamp(((p - a) | ab) / l2, 0.0, 1.0);
+  return a + ab * t;
+}
+
+bool normals_agree(const Vec3& before, const Vec3& after, double min_cos) {
+  const double nb = before.norm(), na = after.norm();
+  if (!(nb > 0) || !(na > 0)) return false;
+  return (before | after) > min_cos * nb * na;
+}
+
+void face_vertices(const TriMesh& mesh, OpenMesh::FaceHandle f, OpenMesh::VertexHandle out[3]) {
+  auto h = mesh.halfedge_handle(f);
+  out[0] = mesh.to_vertex_handle(h);
+  h = mesh.next_halfedge_handle(h);
+  out[1] = mesh.to_vertex_handle(h);
+  h = mesh.next_halfedge_handle(h);
+  out[2] = mesh.to_vertex_handle(h);
+}
+
+Vec3 face_normal(const TriMesh& mesh, OpenMesh::FaceHandle f) {
+  OpenMesh::VertexHandle v[3];
+  face_vertices(mesh, f, v);
+  return cross_normal(mesh.point(v[0]), mesh.point(v[1]), mesh.point(v[2]));
+}
+
+std::vector<Vec3> vertex_normals(const TriMesh& mesh, unsigned threads) {
+  std::vector<Vec3> normals(mesh.n_vertices(), Vec3(0, 0, 0));
+  parallel_for(mesh.n_vertices(), threads, [&](std::size_t i) {
+    const auto v = mesh.vertex_handle(static_cast<unsigned>(i));
+    Vec3 n(0, 0, 0);
+    for (auto f : mesh.vf_range(v)) n += face_normal(mesh, f);
+    const double len = n.norm();
+    normals[i] = len > 0 ? n / len : Vec3(0, 0, 0);
+  });
+  return normals;
+}
+
+double star_min_angle(const TriMesh& mesh, OpenMesh::VertexHandle v) {
+  double worst = M_PI;
+  for (auto f : mesh.vf_range(v)) {
+    OpenMesh::VertexHandle c[3];
+    face_vertices(mesh, f, c);
+    worst = std::min(worst, min_angle(mesh.point(c[0]), mesh.point(c[1]), mesh.point(c[2])));
+  }
+  return worst;
+}
+
+bool move_is_safe(const TriMesh& mesh, OpenMesh::VertexHandle v, const Vec3& p) {
+  const double floor_angle = std::min(kMinAngle, star_min_angle(mesh, v));
+  for (auto f : mesh.vf_range(v)) {
+    OpenMesh::VertexHandle c[3];
+    face_vertices(mesh, f, c);
+    Vec3 q[3];
+    for (int k = 0; k < 3; ++k) q[k] = c[k] == v ? p : mesh.point(c[k]);
+    const Vec3 before = face_normal(mesh, f);
+    const Vec3 after = cross_normal(q[0], q[1], q[2]);
+    if (!normals_agree(before, after)) return false;
+    if (min_angle(q[0], q[1], q[2]) < floor_angle) return false;
+  }
+  return true;
+}
+
+}  // namespace remesh::geom

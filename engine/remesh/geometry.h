@@ -1,0 +1,52 @@
+#pragma once
+/// \file geometry.h
+/// Small geometric helpers shared by the steps: angles, closest point on a triangle, normals and the
+/// fold / degeneracy tests every mesh edit must pass.
+
+#include <vector>
+
+#include "core/mesh.h"
+
+namespace remesh::geom {
+
+/// Smallest interior angle of triangle (a, b, c), in radians; 0 for a degenerate triangle.
+double min_angle(const Vec3& a, const Vec3& b, const Vec3& c);
+
+/// Unnormalised normal (b - a) x (c - a); its length is twice the area.
+inline Vec3 cross_normal(const Vec3& a, const Vec3& b, const Vec3& c) { return (b - a) % (c - a); }
+
+/// Closest point to p on triangle (a, b, c) (Ericson, Real-Time Collision Detection 5.1.5).
+Vec3 closest_point_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c);
+
+/// Closest point to p on segment [a, b].
+Vec3 closest_point_on_segment(const Vec3& p, const Vec3& a, const Vec3& b);
+
+/// Smallest angle (radians) a triangle created by an edit may have. Below it a triangle counts as
+/// degenerate; an edit may still create one no worse than the worst it replaces.
+constexpr double kMinAngle = 1.0 * 3.14159265358979323846 / 180.0;
+
+/// Smallest cosine between the normal of a triangle before and after an edit (about 60 degrees).
+/// Below it the edit folds or badly tilts the triangle and is refused.
+constexpr double kMinNormalCos = 0.5;
+
+/// True when `after` (unnormalised normal) agrees with `before`: both non-zero and the angle between
+/// them is below acos(min_cos).
+bool normals_agree(const Vec3& before, const Vec3& after, double min_cos = kMinNormalCos);
+
+/// The three corner vertices of face f.
+void face_vertices(const TriMesh& mesh, OpenMesh::FaceHandle f, OpenMesh::VertexHandle out[3]);
+
+/// Unnormalised normal of face f from the current points.
+Vec3 face_normal(const TriMesh& mesh, OpenMesh::FaceHandle f);
+
+/// Area-weighted unit vertex normals, one per vertex index (zero for isolated vertices). Parallel.
+std::vector<Vec3> vertex_normals(const TriMesh& mesh, unsigned threads);
+
+/// Smallest angle (radians) of the faces around v (the worst angle of its star).
+double star_min_angle(const TriMesh& mesh, OpenMesh::VertexHandle v);
+
+/// Would moving v to `p` keep every face of its star unfolded and non-degenerate? A new face may
+/// be below kMinAngle only if it is no worse than the worst face of the star before the move.
+bool move_is_safe(const TriMesh& mesh, OpenMesh::VertexHandle v, const Vec3& p);
+
+}  // namespace remesh::geom

@@ -1,0 +1,200 @@
+#include "remesh/interval_cleanup.h"
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include "remesh/geometry.h"
+#include "remesh/projection.h"
+#include "remesh/reposition.h"
+#include "remesh/stellar_operations.h"
+#include "remesh/valence_flips.h"
+
+namespace remesh {
+
+using OpenMesh::EdgeHandle;
+using OpenMesh::HalfedgeHandle;
+using OpenMesh::VertexHandle;
+
+namespace {
+
+class Cleanup {
+ public:
+  Cleanup(TriMesh& mesh, const ReferenceSurface& reference, double e_min, double e_max, double f)
+      : mesh_(mesh), reference_(reference), e_min_(e_min), e_max_(e_max), f_(f), sizes_(mesh) {}
+
+  bool inside(double length) const { return length >= e_min_ && length <= e_max_; }
+  double outside_by(double length) const { return std::max({0.0, e_min_ - length, length - e_max_}); }
+  double target() const { return 0.5 * (e_min_ + e_max_); }
+
+  std::size_t count_outside() const {
+    std::size_t n = 0;
+    for (auto e : mesh_.edges())
+      if (!inside(mesh_.calc_edge_length(e))) ++n;
+    return n;
+  }
+
+  /// One round: every edge outside the interval, worst first.
+  std::size_t round(CleanupCounts& counts) {
+    std::vector<std::pair<double, unsigned>> list;
+    for (auto e : mesh_.edges()) {
+      const double d = outside_by(mesh_.calc_edge_length(e));
+      if (d > 0) list.emplace_back(-d, e.idx());
+    }
+    std::sort(list.begin(), list.end());
+    std::size_t fixes = 0;
+    for (const auto& item : list) {
+      const EdgeHandle e = mesh_.edge_handle(item.second);
+      if (mesh_.status(e).deleted()) continue;
+      const double length = mesh_.calc_edge_length(e);
+      if (inside(length)) continue;
+      const bool is_long = length > e_max_;
+      if (try_flip(e)) {
+        ++counts.flips;
+      } else if (!is_long && try_collapse(e)) {
+        ++counts.collapses;
+      } else if (is_long && try_split(e)) {
+        ++counts.splits;
+      } else if (try_relocate(e)) {
+        ++counts.relocations;
+      } else {
+        continue;
+      }
+      ++fixes;
+    }
+    mesh_.garbage_collection();
+    sizes_ = ComponentSizes(mesh_);
+    return fixes;
+  }
+
+ private:
+  Vec3 normal_at(VertexHandle v) const {
+    Vec3 n(0, 0, 0);
+    for (auto f : mesh_.vf_range(v)) n += geom::face_normal(mesh_, f);
+    const double len = n.norm();
+    return len > 0 ? n / len : n;
+  }
+
+  bool try_flip(EdgeHandle e) {
+    if (mesh_.is_boundary(e)) return false;
+    const HalfedgeHandle h0 = mesh_.halfedge_handle(e, 0), h1 = mesh_.halfedge_handle(e, 1);
+    const VertexHandle v2 = mesh_.to_vertex_handle(mesh_.next_halfedge_handle(h0));
+    const VertexHandle v3 = mesh_.to_vertex_handle(mesh_.next_halfedge_handle(h1));
+    if (!inside((mesh_.point(v2) - mesh_.point(v3)).norm())) return false;
+    if (!flip_is_safe(mesh_, e, f_)) return false;
+    mesh_.flip(e);
+    return true;
+  }
+
+  bool try_collapse(EdgeHandle e) {
+    CollapsePlan plan;
+    if (!plan_collapse(mesh_, e, target(), e_max_, sizes_, plan)) return false;
+    const VertexHandle kept = mesh_.to_vertex_handle(plan.halfedge);
+    const VertexHandle removed = mesh_.from_vertex_handle(plan.halfedge);
+    Vec3 p = plan.position;
+    if (!mesh_.is_boundary(kept) || mesh_.is_boundary(mesh_.edge_handle(plan.halfedge)))
+      p = project_vertex(mesh_, kept, p, normal_at(kept) + normal_at(removed), reference_);
+    if (!collapse_geometry_ok(mesh_, plan.halfedge, p, e_max_)) return false;
+    for (VertexHandle end : {kept, removed})
+      for (auto w : mesh_.vv_range(end))
+        if (w != kept && w != removed && !inside((mesh_.point(w) - p).norm())) return false;
+    plan.position = p;
+    apply_collapse(mesh_, plan, sizes_);
+    return true;
+  }
+
+  bool try_split(EdgeHandle e) {
+    const HalfedgeHandle h = mesh_.halfedge_handle(e, 0);
+    const VertexHandle v0 = mesh_.from_vertex_handle(h), v1 = mesh_.to_vertex_handle(h);
+    const Vec3 a = mesh_.point(v0), b = mesh_.point(v1);
+    Vec3 p = a + (b - a) * equalizing_parameter(a, b, split_neighbours(mesh_, e), target());
+    if (mesh_.is_boundary(e)) {
+      p = reference_.has_boundary() ? reference_.closest_boundary_point(p) : p;
+    } else {
+      p = reference_.closest_point(p, normal_at(v0) + normal_at(v1));
+    }
+    // New edges inside, new triangles unfolded and not degenerate.
+    for (const Vec3& q : split_neighbours(mesh_, e))
+      if (!inside((q - p).norm())) return false;
+    for (int s = 0; s < 2; ++s) {
+      const HalfedgeHandle g = mesh_.halfedge_handle(e, s);
+      if (mesh_.is_boundary(g)) continue;
+      const Vec3& x = mesh_.point(mesh_.from_vertex_handle(g));
+      const Vec3& y = mesh_.point(mesh_.to_vertex_handle(g));
+      const Vec3& z = mesh_.point(mesh_.to_vertex_handle(mesh_.next_halfedge_handle(g)));
+      const Vec3 before = geom::cross_normal(x, y, z);
+      const double floor_angle = std::min(geom::kMinAngle, geom::min_angle(x, y, z));
+      for (const auto& [u, w] : {std::pair<Vec3, Vec3>{x, p}, std::pair<Vec3, Vec3>{p, y}}) {
+        if (!geom::normals_agree(before, geom::cross_normal(u, w, z))) return false;
+        if (geom::min_angle(u, w, z) < floor_angle) return false;
+      }
+    }
+    const VertexHandle v = mesh_.split(e, p);
+    sizes_.on_split(v, v0);
+    return true;
+  }
+
+  std::size_t outside_around(VertexHandle v, const Vec3& p) const {
+    std::size_t n = 0;
+    for (auto w : mesh_.vv_range(v))
+      if (!inside((mesh_.point(w) - p).norm())) ++n;
+    return n;
+  }
+
+  bool relocate(VertexHandle v) {
+    if (mesh_.is_boundary(v)) return false;
+    const Vec3 start = mesh_.point(v);
+    const Vec3 n = normal_at(v);
+    const double margin = 0.05 * (e_max_ - e_min_);
+    const double lo = e_min_ + margin, hi = e_max_ - margin;
+    Vec3 x = start;
+    for (int it = 0; it < 30; ++it) {
+      Vec3 grad(0, 0, 0);
+      int active = 0;
+      for (auto w : mesh_.vv_range(v)) {
+        const Vec3 d = x - mesh_.point(w);
+        const double l = d.norm();
+        if (!(l > 0)) continue;
+        const double excess = l < lo ? l - lo : (l > hi ? l - hi : 0.0);
+        if (excess == 0) continue;
+        grad += d * (excess / l);
+        ++active;
+      }
+      if (active == 0) break;
+      grad -= n * (grad | n);
+      x -= grad * (1.0 / active);
+    }
+    const Vec3 p = reference_.closest_point(x, n);
+    if (outside_around(v, p) >= outside_around(v, start)) return false;
+    if (!geom::move_is_safe(mesh_, v, p)) return false;
+    mesh_.point(v) = p;
+    return true;
+  }
+
+  bool try_relocate(EdgeHandle e) {
+    const HalfedgeHandle h = mesh_.halfedge_handle(e, 0);
+    return relocate(mesh_.from_vertex_handle(h)) || relocate(mesh_.to_vertex_handle(h));
+  }
+
+  TriMesh& mesh_;
+  const ReferenceSurface& reference_;
+  double e_min_, e_max_, f_;
+  ComponentSizes sizes_;
+};
+
+}  // namespace
+
+CleanupCounts interval_cleanup(TriMesh& mesh, const ReferenceSurface& reference, double e_min, double e_max,
+                               double flip_factor, int rounds) {
+  mesh.garbage_collection();
+  Cleanup cleanup(mesh, reference, e_min, e_max, flip_factor);
+  CleanupCounts counts;
+  counts.outside_before = cleanup.count_outside();
+  if (counts.outside_before > 0)
+    for (int r = 0; r < rounds; ++r)
+      if (cleanup.round(counts) == 0) break;
+  counts.outside_after = cleanup.count_outside();
+  return counts;
+}
+
+}  // namespace remesh

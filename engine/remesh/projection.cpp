@@ -1,0 +1,43 @@
+#include "remesh/projection.h"
+
+#include <algorithm>
+#include <vector>
+
+#include "core/parallel.h"
+#include "remesh/geometry.h"
+
+namespace remesh {
+
+Vec3 project_vertex(const TriMesh& mesh, OpenMesh::VertexHandle v, const Vec3& p, const Vec3& normal,
+                    const ReferenceSurface& reference) {
+  if (mesh.is_boundary(v) && reference.has_boundary()) return reference.closest_boundary_point(p);
+  return reference.closest_point(p, normal);
+}
+
+double project_onto_reference(TriMesh& mesh, const ReferenceSurface& reference, unsigned threads) {
+  const std::size_t n = mesh.n_vertices();
+  const std::vector<Vec3> normals = geom::vertex_normals(mesh, threads);
+  std::vector<Vec3> target(n);
+  constexpr std::size_t kBlock = 512;
+  std::vector<double> block_max(block_count(n, kBlock), 0.0);
+  parallel_blocks(n, kBlock, threads, [&](std::size_t b, std::size_t e, std::size_t block) {
+    double worst = 0;
+    for (std::size_t i = b; i < e; ++i) {
+      const auto v = mesh.vertex_handle(static_cast<unsigned>(i));
+      const Vec3 p = mesh.point(v);
+      if (mesh.status(v).deleted() || mesh.is_isolated(v)) {
+        target[i] = p;
+        continue;
+      }
+      target[i] = project_vertex(mesh, v, p, normals[i], reference);
+      worst = std::max(worst, (target[i] - p).norm());
+    }
+    block_max[block] = worst;
+  });
+  for (std::size_t i = 0; i < n; ++i) mesh.point(mesh.vertex_handle(static_cast<unsigned>(i))) = target[i];
+  double worst = 0;
+  for (double d : block_max) worst = std::max(worst, d);
+  return worst;
+}
+
+}  // namespace remesh

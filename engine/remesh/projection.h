@@ -1,0 +1,23 @@
+#pragma once
+/// \file projection.h
+/// Algorithm 6: move every vertex to the closest point of the reference surface (the triangles
+/// incident to its 30 nearest reference vertices, found with the kd-tree of ReferenceSurface).
+/// Boundary vertices go to the closest point of the reference's boundary curves, so boundaries stay
+/// boundaries. Where two sheets are close, the candidate whose normal agrees with the vertex normal
+/// wins. Parallel over vertices; each vertex's result depends only on the mesh before the step.
+
+#include "core/mesh.h"
+#include "remesh/reference_surface.h"
+
+namespace remesh {
+
+/// Projects every live, non-isolated vertex of `mesh` onto `reference`. Returns the largest
+/// distance a vertex moved (mesh units).
+double project_onto_reference(TriMesh& mesh, const ReferenceSurface& reference, unsigned threads);
+
+/// The position one vertex would take: closest_boundary_point for boundary vertices, else
+/// closest_point with `normal` as the hint.
+Vec3 project_vertex(const TriMesh& mesh, OpenMesh::VertexHandle v, const Vec3& p, const Vec3& normal,
+                    const ReferenceSurface& reference);
+
+}  // namespace remesh

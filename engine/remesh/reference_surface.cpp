@@ -1,0 +1,192 @@
+#include "remesh/reference_surface.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <vector>
+
+#include <nanoflann.hpp>
+
+#include "core/errors.h"
+#include "remesh/geometry.h"
+
+namespace remesh {
+
+namespace {
+
+/// nanoflann's view of the reference vertices.
+struct PointCloud {
+  const std::vector<Vec3>* points = nullptr;
+  std::size_t kdtree_get_point_count() const { return points->size(); }
+  double kdtree_get_pt(std::uint32_t i, std::size_t dim) const { return (*points)[i][dim]; }
+  template <class Box>
+  bool kdtree_get_bbox(Box&) const { return false; }
+};
+
+using KdTree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<double, PointCloud>,
+                                                   PointCloud, 3, std::uint32_t>;
+
+/// Compressed lists: items of key i are items[offsets[i] .. offsets[i+1]).
+struct Csr {
+  std::vector<std::uint32_t> offsets, items;
+};
+
+}  // namespace
+
+struct ReferenceSurface::Impl {
+  std::vector<Vec3> points;
+  std::vector<std::array<std::uint32_t, 3>> triangles;
+  std::vector<Vec3> unit_normals;   ///< per triangle
+  std::vector<Vec3> centres;        ///< per triangle: centroid
+  std::vector<double> radii;        ///< per triangle: largest distance centroid -> corner
+  Csr vertex_triangles;             ///< triangles incident to each vertex
+  Csr vertex_boundary;              ///< other end of each boundary edge at a vertex
+  std::size_t boundary_edges = 0;
+  std::size_t neighbours = 30;
+  PointCloud cloud;
+  std::unique_ptr<KdTree> tree;
+};
+
+ReferenceSurface::ReferenceSurface(const TriMesh& mesh, std::size_t neighbours)
+    : impl_(std::make_unique<Impl>()) {
+  Impl& m = *impl_;
+  m.neighbours = std::max<std::size_t>(1, neighbours);
+  std::vector<std::uint32_t> index(mesh.n_vertices(), UINT32_MAX);
+  for (auto v : mesh.vertices()) {
+    if (mesh.status(v).deleted()) continue;
+    index[v.idx()] = static_cast<std::uint32_t>(m.points.size());
+    m.points.push_back(mesh.point(v));
+  }
+  for (auto f : mesh.faces()) {
+    if (mesh.status(f).deleted()) continue;
+    OpenMesh::VertexHandle c[3];
+    geom::face_vertices(mesh, f, c);
+    std::array<std::uint32_t, 3> t{index[c[0].idx()], index[c[1].idx()], index[c[2].idx()]};
+    m.triangles.push_back(t);
+  }
+  if (m.triangles.empty()) throw MeshError("reference surface has no triangles");
+  const std::size_t nv = m.points.size(), nt = m.triangles.size();
+  m.unit_normals.resize(nt);
+  m.centres.resize(nt);
+  m.radii.resize(nt);
+  m.vertex_triangles.offsets.assign(nv + 1, 0);
+  for (std::size_t t = 0; t < nt; ++t) {
+    const auto& tri = m.triangles[t];
+    const Vec3 &a = m.points[tri[0]], &b = m.points[tri[1]], &c = m.points[tri[2]];
+    Vec3 n = geom::cross_normal(a, b, c);
+    const double len = n.norm();
+    m.unit_normals[t] = len > 0 ? n / len : Vec3(0, 0, 0);
+    m.centres[t] = (a + b + c) / 3.0;
+    m.radii[t] = std::sqrt(std::max({(a - m.centres[t]).sqrnorm(), (b - m.centres[t]).sqrnorm(),
+                                      (c - m.centres[t]).sqrnorm()}));
+    for (auto v : tri) ++m.vertex_triangles.offsets[v + 1];
+  }
+  for (std::size_t v = 0; v < nv; ++v) m.vertex_triangles.offsets[v + 1] += m.vertex_triangles.offsets[v];
+  m.vertex_triangles.items.resize(m.vertex_triangles.offsets[nv]);
+  {
+    std::vector<std::uint32_t> fill(m.vertex_triangles.offsets.begin(), m.vertex_triangles.offsets.end() - 1);
+    for (std::size_t t = 0; t < nt; ++t)
+      for (auto v : m.triangles[t]) m.vertex_triangles.items[fill[v]++] = static_cast<std::uint32_t>(t);
+  }
+  // Boundary edges, listed at both ends.
+  m.vertex_boundary.offsets.assign(nv + 1, 0);
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> segments;
+  for (auto e : mesh.edges()) {
+    if (mesh.status(e).deleted() || !mesh.is_boundary(e)) continue;
+    const auto h = mesh.halfedge_handle(e, 0);
+    const std::uint32_t a = index[mesh.from_vertex_handle(h).idx()], b = index[mesh.to_vertex_handle(h).idx()];
+    segments.emplace_back(a, b);
+    ++m.vertex_boundary.offsets[a + 1];
+    ++m.vertex_boundary.offsets[b + 1];
+  }
+  m.boundary_edges = segments.size();
+  for (std::size_t v = 0; v < nv; ++v) m.vertex_boundary.offsets[v + 1] += m.vertex_boundary.offsets[v];
+  m.vertex_boundary.items.resize(m.vertex_boundary.offsets[nv]);
+  {
+    std::vector<std::uint32_t> fill(m.vertex_boundary.offsets.begin(), m.vertex_boundary.offsets.end() - 1);
+    for (auto [a, b] : segments) {
+      m.vertex_boundary.items[fill[a]++] = b;
+      m.vertex_boundary.items[fill[b]++] = a;
+    }
+  }
+  m.cloud.points = &m.points;
+  m.tree = std::make_unique<KdTree>(3, m.cloud, nanoflann::KDTreeSingleIndexAdaptorParams(16));
+  m.tree->buildIndex();
+}
+
+ReferenceSurface::~ReferenceSurface() = default;
+ReferenceSurface::ReferenceSurface(ReferenceSurface&&) noexcept = default;
+ReferenceSurface& ReferenceSurface::operator=(ReferenceSurface&&) noexcept = default;
+
+std::size_t ReferenceSurface::n_vertices() const { return impl_->points.size(); }
+std::size_t ReferenceSurface::n_triangles() const { return impl_->triangles.size(); }
+bool ReferenceSurface::has_boundary() const { return impl_->boundary_edges > 0; }
+
+Vec3 ReferenceSurface::closest_point(const Vec3& p, const Vec3& normal_hint) const {
+  const Impl& m = *impl_;
+  constexpr std::size_t kMaxK = 64;
+  std::uint32_t idx[kMaxK];
+  double dist2[kMaxK];
+  const std::size_t k = std::min({m.neighbours, kMaxK, m.points.size()});
+  const double q[3] = {p[0], p[1], p[2]};
+  const std::size_t found = m.tree->knnSearch(q, k, idx, dist2);
+
+  // Best candidate overall and best candidate whose normal agrees with the hint. The agreeing one
+  // wins when it is nearly as close (two sheets close together: stay on the vertex's own sheet).
+  const bool use_hint = normal_hint.sqrnorm() > 0;
+  constexpr double kInf = std::numeric_limits<double>::max();
+  Vec3 best = m.points[idx[0]], best_agree = best;
+  double best_d2 = kInf, agree_d2 = kInf, best_d = kInf, agree_d = kInf;
+  for (std::size_t i = 0; i < found; ++i) {
+    const std::uint32_t v = idx[i];
+    for (std::uint32_t j = m.vertex_triangles.offsets[v]; j < m.vertex_triangles.offsets[v + 1]; ++j) {
+      const std::uint32_t t = m.vertex_triangles.items[j];
+      const bool agrees = use_hint && (m.unit_normals[t] | normal_hint) > 0;
+      // Skip a triangle whose bounding sphere is farther than the candidate it could beat.
+      const double bound = agrees ? std::max(best_d, agree_d) : best_d;
+      if (bound < kInf) {
+        const double reach = m.radii[t] + bound;
+        if ((p - m.centres[t]).sqrnorm() > reach * reach) continue;
+      }
+      const auto& tri = m.triangles[t];
+      const Vec3 c = geom::closest_point_on_triangle(p, m.points[tri[0]], m.points[tri[1]], m.points[tri[2]]);
+      const double d2 = (c - p).sqrnorm();
+      if (d2 < best_d2) best_d2 = d2, best_d = std::sqrt(d2), best = c;
+      if (agrees && d2 < agree_d2) agree_d2 = d2, agree_d = std::sqrt(d2), best_agree = c;
+    }
+  }
+  // "Nearly as close": within twice the distance of the closest candidate (plus a hair for points
+  // already on the surface).
+  if (use_hint && agree_d2 < std::numeric_limits<double>::max()) {
+    const double scale = 1e-12 * (1.0 + p.sqrnorm());
+    if (agree_d2 <= 4.0 * best_d2 + scale) return best_agree;
+  }
+  return best;
+}
+
+Vec3 ReferenceSurface::closest_boundary_point(const Vec3& p) const {
+  const Impl& m = *impl_;
+  if (m.boundary_edges == 0) return closest_point(p);
+  constexpr std::size_t kMaxK = 64;
+  std::uint32_t idx[kMaxK];
+  double dist2[kMaxK];
+  const std::size_t k = std::min({m.neighbours, kMaxK, m.points.size()});
+  const double q[3] = {p[0], p[1], p[2]};
+  const std::size_t found = m.tree->knnSearch(q, k, idx, dist2);
+  Vec3 best(0, 0, 0);
+  double best_d2 = std::numeric_limits<double>::max();
+  for (std::size_t i = 0; i < found; ++i) {
+    const std::uint32_t v = idx[i];
+    for (std::uint32_t j = m.vertex_boundary.offsets[v]; j < m.vertex_boundary.offsets[v + 1]; ++j) {
+      const Vec3 c = geom::closest_point_on_segment(p, m.points[v], m.points[m.vertex_boundary.items[j]]);
+      const double d2 = (c - p).sqrnorm();
+      if (d2 < best_d2) best_d2 = d2, best = c;
+    }
+  }
+  if (best_d2 == std::numeric_limits<double>::max()) return closest_point(p);
+  return best;
+}
+
+}  // namespace remesh

@@ -1,0 +1,181 @@
+#include "remesh/stellar_operations.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <cstdlib>
+
+#include "remesh/geometry.h"
+#include "remesh/reposition.h"
+
+namespace remesh {
+
+using OpenMesh::EdgeHandle;
+using OpenMesh::FaceHandle;
+using OpenMesh::HalfedgeHandle;
+using OpenMesh::VertexHandle;
+
+ComponentSizes::ComponentSizes(const TriMesh& mesh) : label_(mesh.n_vertices(), UINT32_MAX) {
+  std::vector<VertexHandle> stack;
+  for (auto seed : mesh.vertices()) {
+    if (mesh.status(seed).deleted() || label_[seed.idx()] != UINT32_MAX) continue;
+    const unsigned id = static_cast<unsigned>(sizes_.size());
+    sizes_.push_back(0);
+    label_[seed.idx()] = id;
+    stack.assign(1, seed);
+    while (!stack.empty()) {
+      const VertexHandle v = stack.back();
+      stack.pop_back();
+      ++sizes_[id];
+      for (auto w : mesh.vv_range(v)) {
+        if (label_[w.idx()] != UINT32_MAX) continue;
+        label_[w.idx()] = id;
+        stack.push_back(w);
+      }
+    }
+  }
+}
+
+void ComponentSizes::on_split(VertexHandle new_vertex, VertexHandle neighbour) {
+  if (label_.size() <= static_cast<std::size_t>(new_vertex.idx())) label_.resize(new_vertex.idx() + 1, 0);
+  label_[new_vertex.idx()] = label_[neighbour.idx()];
+  ++sizes_[label_[neighbour.idx()]];
+}
+
+void ComponentSizes::on_collapse(VertexHandle removed) { --sizes_[label_[removed.idx()]]; }
+
+namespace {
+
+/// Would the triangles made by splitting e at p be non-degenerate (no worse than kMinAngle, or than
+/// the triangle they replace)?
+bool split_point_ok(const TriMesh& mesh, EdgeHandle e, const Vec3& p) {
+  for (int s = 0; s < 2; ++s) {
+    const HalfedgeHandle h = mesh.halfedge_handle(e, s);
+    if (mesh.is_boundary(h)) continue;
+    const Vec3& a = mesh.point(mesh.from_vertex_handle(h));
+    const Vec3& b = mesh.point(mesh.to_vertex_handle(h));
+    const Vec3& c = mesh.point(mesh.to_vertex_handle(mesh.next_halfedge_handle(h)));
+    const double floor_angle = std::min(geom::kMinAngle, geom::min_angle(a, b, c));
+    if (geom::min_angle(a, p, c) < floor_angle || geom::min_angle(p, b, c) < floor_angle) return false;
+  }
+  return true;
+}
+
+/// Is h's boundary loop longer than 3 edges? (Collapsing an edge of a 3-edge hole would close it.)
+bool boundary_loop_longer_than_3(const TriMesh& mesh, HalfedgeHandle h) {
+  if (!mesh.is_boundary(h)) h = mesh.opposite_halfedge_handle(h);
+  HalfedgeHandle g = h;
+  for (int i = 0; i < 3; ++i) g = mesh.next_halfedge_handle(g);
+  return g != h;
+}
+
+}  // namespace
+
+VertexHandle split_edge(TriMesh& mesh, EdgeHandle e, double target, ComponentSizes& sizes) {
+  const HalfedgeHandle h = mesh.halfedge_handle(e, 0);
+  const VertexHandle v0 = mesh.from_vertex_handle(h);
+  const Vec3 a = mesh.point(v0), b = mesh.point(mesh.to_vertex_handle(h));
+  const double t = equalizing_parameter(a, b, split_neighbours(mesh, e), target);
+  Vec3 p = a + (b - a) * t;
+  if (!split_point_ok(mesh, e, p)) {
+    p = (a + b) * 0.5;
+    if (!split_point_ok(mesh, e, p)) return VertexHandle();
+  }
+  const VertexHandle v = mesh.split(e, p);
+  sizes.on_split(v, v0);
+  return v;
+}
+
+bool collapse_geometry_ok(const TriMesh& mesh, HalfedgeHandle h, const Vec3& p, double max_length) {
+  const VertexHandle v0 = mesh.from_vertex_handle(h), v1 = mesh.to_vertex_handle(h);
+  const FaceHandle gone0 = mesh.face_handle(h), gone1 = mesh.face_handle(mesh.opposite_halfedge_handle(h));
+  const double floor_angle = std::min({geom::kMinAngle, geom::star_min_angle(mesh, v0), geom::star_min_angle(mesh, v1)});
+  for (VertexHandle end : {v0, v1}) {
+    for (auto f : mesh.vf_range(end)) {
+      if (f == gone0 || f == gone1) continue;
+      VertexHandle c[3];
+      geom::face_vertices(mesh, f, c);
+      Vec3 q[3];
+      for (int k = 0; k < 3; ++k) q[k] = (c[k] == v0 || c[k] == v1) ? p : mesh.point(c[k]);
+      if (!geom::normals_agree(geom::face_normal(mesh, f), geom::cross_normal(q[0], q[1], q[2]))) return false;
+      if (geom::min_angle(q[0], q[1], q[2]) < floor_angle) return false;
+    }
+    for (auto w : mesh.vv_range(end)) {
+      if (w == v0 || w == v1) continue;
+      if ((mesh.point(w) - p).norm() > max_length) return false;
+    }
+  }
+  return true;
+}
+
+bool plan_collapse(const TriMesh& mesh, EdgeHandle e, double target, double max_length,
+                   const ComponentSizes& sizes, CollapsePlan& plan) {
+  HalfedgeHandle h = mesh.halfedge_handle(e, 0);
+  VertexHandle v0 = mesh.from_vertex_handle(h), v1 = mesh.to_vertex_handle(h);
+  if (sizes.size_of(v0) <= 4) return false;
+  const bool b0 = mesh.is_boundary(v0), b1 = mesh.is_boundary(v1);
+  Vec3 p;
+  if (mesh.is_boundary(e)) {
+    // Along the boundary curve: the kept vertex stays on the edge.
+    if (!boundary_loop_longer_than_3(mesh, h)) return false;
+    const Vec3 a = mesh.point(v0), b = mesh.point(v1);
+    p = a + (b - a) * equalizing_parameter(a, b, collapse_neighbours(mesh, h), target);
+  } else if (b0 && b1) {
+    return false;  // interior edge between two boundary vertices: would pinch
+  } else if (b0 || b1) {
+    if (b0) h = mesh.opposite_halfedge_handle(h), std::swap(v0, v1);  // remove the interior end
+    p = mesh.point(v1);
+  } else {
+    const Vec3 a = mesh.point(v0), b = mesh.point(v1);
+    p = a + (b - a) * equalizing_parameter(a, b, collapse_neighbours(mesh, h), target);
+  }
+  // is_collapse_ok is not const in OpenMesh 9 but only reads (it uses status bits it resets).
+  if (!const_cast<TriMesh&>(mesh).is_collapse_ok(h)) return false;
+  if (!collapse_geometry_ok(mesh, h, p, max_length)) return false;
+  plan.halfedge = h;
+  plan.position = p;
+  return true;
+}
+
+VertexHandle apply_collapse(TriMesh& mesh, const CollapsePlan& plan, ComponentSizes& sizes) {
+  const VertexHandle removed = mesh.from_vertex_handle(plan.halfedge);
+  const VertexHandle kept = mesh.to_vertex_handle(plan.halfedge);
+  mesh.collapse(plan.halfedge);
+  sizes.on_collapse(removed);
+  mesh.point(kept) = plan.position;
+  return kept;
+}
+
+StellarCounts stellar_operations(TriMesh& mesh, const std::vector<unsigned>& list, double m_i, double sigma) {
+  StellarCounts counts;
+  ComponentSizes sizes(mesh);
+  std::vector<char> visited(mesh.n_vertices(), 0);
+  auto visit_star = [&](VertexHandle v) {
+    if (visited.size() < mesh.n_vertices()) visited.resize(mesh.n_vertices(), 0);
+    visited[v.idx()] = 1;
+    for (auto w : mesh.vv_range(v)) visited[w.idx()] = 1;
+  };
+  for (unsigned index : list) {
+    const EdgeHandle e = mesh.edge_handle(index);
+    if (mesh.status(e).deleted()) continue;
+    const HalfedgeHandle h = mesh.halfedge_handle(e, 0);
+    const VertexHandle v0 = mesh.from_vertex_handle(h), v1 = mesh.to_vertex_handle(h);
+    if (visited[v0.idx()] && visited[v1.idx()]) continue;
+    const double length = mesh.calc_edge_length(e);
+    if (length > m_i + sigma) {
+      const VertexHandle v = split_edge(mesh, e, m_i, sizes);
+      if (!v.is_valid()) continue;
+      ++counts.splits;
+      visit_star(v);
+    } else if (length < m_i - sigma) {
+      CollapsePlan plan;
+      static const double slack = getenv("RM_SLACK") ? atof(getenv("RM_SLACK")) : 0.0;
+      if (!plan_collapse(mesh, e, m_i, m_i + sigma + slack, sizes, plan)) continue;
+      visit_star(apply_collapse(mesh, plan, sizes));
+      ++counts.collapses;
+    }
+  }
+  return counts;
+}
+
+}  // namespace remesh

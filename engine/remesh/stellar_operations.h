@@ -1,0 +1,65 @@
+#pragma once
+/// \file stellar_operations.h
+/// Algorithm 3: walk the priority list; split long edges, collapse short ones, with visited marking,
+/// eq. 3.1 repositioning and the safety checks that keep the mesh a valid 2-manifold of unchanged
+/// topology with no folded or degenerate triangle:
+/// - a split puts its vertex on the edge (eq. 3.1) and refuses to create a degenerate triangle;
+/// - a collapse must pass OpenMesh's is_collapse_ok (link condition), must not fold a triangle,
+///   create a degenerate one or an edge longer than `max_length`; it never collapses an interior
+///   edge whose two ends lie on the boundary (that would pinch or join two boundary loops), keeps a
+///   boundary vertex on the boundary (an interior vertex collapses onto it; a boundary edge collapses
+///   along itself), never closes a boundary loop of 3 edges, and never takes a component below
+///   4 vertices (a tetrahedron-sized component does not vanish).
+/// The edits leave deleted elements behind: call mesh.garbage_collection() after a pass.
+
+#include <cstddef>
+#include <vector>
+
+#include "core/mesh.h"
+
+namespace remesh {
+
+/// Live-vertex count of each connected component, kept current through splits and collapses.
+class ComponentSizes {
+ public:
+  explicit ComponentSizes(const TriMesh& mesh);
+  std::size_t size_of(OpenMesh::VertexHandle v) const { return sizes_[label_[v.idx()]]; }
+  void on_split(OpenMesh::VertexHandle new_vertex, OpenMesh::VertexHandle neighbour);
+  void on_collapse(OpenMesh::VertexHandle removed);
+
+ private:
+  std::vector<unsigned> label_;
+  std::vector<std::size_t> sizes_;
+};
+
+/// Splits edge e at the point of eq. 3.1 (target edge length `target`). Returns the new vertex, or
+/// an invalid handle when every candidate point would create a degenerate triangle.
+OpenMesh::VertexHandle split_edge(TriMesh& mesh, OpenMesh::EdgeHandle e, double target, ComponentSizes& sizes);
+
+/// A planned collapse: the halfedge whose from-vertex goes away and where the kept vertex ends up.
+struct CollapsePlan {
+  OpenMesh::HalfedgeHandle halfedge;
+  Vec3 position;
+};
+
+/// Chooses direction and position (eq. 3.1, or the boundary vertex, see above) for collapsing e and
+/// checks every rule. Returns false when the collapse is not allowed.
+bool plan_collapse(const TriMesh& mesh, OpenMesh::EdgeHandle e, double target, double max_length,
+                   const ComponentSizes& sizes, CollapsePlan& plan);
+
+/// Would collapsing `h` with the kept vertex at `p` fold or degenerate a triangle, or create an edge
+/// longer than max_length? (Geometric part of plan_collapse; topology is checked there.)
+bool collapse_geometry_ok(const TriMesh& mesh, OpenMesh::HalfedgeHandle h, const Vec3& p, double max_length);
+
+/// Carries out a plan; returns the kept vertex.
+OpenMesh::VertexHandle apply_collapse(TriMesh& mesh, const CollapsePlan& plan, ComponentSizes& sizes);
+
+struct StellarCounts {
+  std::size_t splits = 0, collapses = 0;
+};
+
+/// Algorithm 3 over `list` (edge indices, worst first): long (> m_i + sigma) -> split, short
+/// (< m_i - sigma) -> collapse; skips edges that are gone or whose ends were both visited.
+StellarCounts stellar_operations(TriMesh& mesh, const std::vector<unsigned>& list, double m_i, double sigma);
+
+}  // namespace remesh

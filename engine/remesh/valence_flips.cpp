@@ -1,0 +1,102 @@
+#include "remesh/valence_flips.h"
+
+#include <algorithm>
+#include <cstdlib>
+#include <vector>
+
+#include "remesh/geometry.h"
+
+namespace remesh {
+
+using OpenMesh::EdgeHandle;
+using OpenMesh::HalfedgeHandle;
+using OpenMesh::VertexHandle;
+
+namespace {
+
+/// The quad around interior edge e: v0 -> v1 is the edge, v2 opposite in the face of h0, v3 in the
+/// face of h1.
+struct Quad {
+  VertexHandle v0, v1, v2, v3;
+};
+
+Quad quad_of(const TriMesh& mesh, EdgeHandle e) {
+  const HalfedgeHandle h0 = mesh.halfedge_handle(e, 0), h1 = mesh.halfedge_handle(e, 1);
+  return {mesh.from_vertex_handle(h0), mesh.to_vertex_handle(h0),
+          mesh.to_vertex_handle(mesh.next_halfedge_handle(h0)), mesh.to_vertex_handle(mesh.next_halfedge_handle(h1))};
+}
+
+/// Valence and boundary flag of every vertex, kept current through the flips of a sweep (a sweep
+/// asks for them millions of times; circulating each time dominated the step).
+struct VertexInfo {
+  std::vector<int> valence;
+  std::vector<char> boundary;
+
+  explicit VertexInfo(const TriMesh& mesh) : valence(mesh.n_vertices()), boundary(mesh.n_vertices()) {
+    for (auto v : mesh.vertices()) {
+      valence[v.idx()] = static_cast<int>(mesh.valence(v));
+      boundary[v.idx()] = mesh.is_boundary(v);
+    }
+  }
+  int deviation(VertexHandle v, int delta) const {
+    return std::abs(valence[v.idx()] + delta - (boundary[v.idx()] ? 4 : 6));
+  }
+  bool improves(const Quad& q) const {
+    const int before = deviation(q.v0, 0) + deviation(q.v1, 0) + deviation(q.v2, 0) + deviation(q.v3, 0);
+    const int after = deviation(q.v0, -1) + deviation(q.v1, -1) + deviation(q.v2, +1) + deviation(q.v3, +1);
+    return after < before;
+  }
+  void flipped(const Quad& q) {
+    --valence[q.v0.idx()], --valence[q.v1.idx()], ++valence[q.v2.idx()], ++valence[q.v3.idx()];
+  }
+};
+
+}  // namespace
+
+bool flip_is_safe(const TriMesh& mesh, EdgeHandle e, double f) {
+  if (mesh.status(e).deleted() || mesh.is_boundary(e) || !mesh.is_flip_ok(e)) return false;
+  const Quad q = quad_of(mesh, e);
+  // The ends lose an edge: keep interior valence >= 3 and boundary valence >= 2.
+  for (VertexHandle v : {q.v0, q.v1})
+    if (mesh.valence(v) <= (mesh.is_boundary(v) ? 2u : 3u)) return false;
+  const Vec3 &p0 = mesh.point(q.v0), &p1 = mesh.point(q.v1), &p2 = mesh.point(q.v2), &p3 = mesh.point(q.v3);
+  // Old faces (v0, v1, v2), (v1, v0, v3); new faces (v3, v1, v2), (v2, v0, v3).
+  const Vec3 old_a = geom::cross_normal(p0, p1, p2), old_b = geom::cross_normal(p1, p0, p3);
+  const Vec3 new_a = geom::cross_normal(p3, p1, p2), new_b = geom::cross_normal(p2, p0, p3);
+  for (const Vec3& n : {new_a, new_b})
+    if (!geom::normals_agree(old_a, n) || !geom::normals_agree(old_b, n)) return false;
+  const double before = std::min(geom::min_angle(p0, p1, p2), geom::min_angle(p1, p0, p3));
+  const double after = std::min(geom::min_angle(p3, p1, p2), geom::min_angle(p2, p0, p3));
+  return after >= f * before && after >= std::min(geom::kMinAngle, before);
+}
+
+bool flip_improves(const TriMesh& mesh, EdgeHandle e, double f) {
+  if (mesh.status(e).deleted() || mesh.is_boundary(e)) return false;
+  return VertexInfo(mesh).improves(quad_of(mesh, e)) && flip_is_safe(mesh, e, f);
+}
+
+std::size_t valence_flip_sweep(TriMesh& mesh, double f) {
+  std::size_t flips = 0;
+  VertexInfo info(mesh);
+  for (auto e : mesh.edges()) {
+    if (mesh.is_boundary(e)) continue;
+    const Quad q = quad_of(mesh, e);
+    if (!info.improves(q) || !flip_is_safe(mesh, e, f)) continue;
+    mesh.flip(e);
+    info.flipped(q);
+    ++flips;
+  }
+  return flips;
+}
+
+std::size_t valence_flips(TriMesh& mesh, double f, int max_sweeps) {
+  std::size_t total = 0;
+  for (int s = 0; s < max_sweeps; ++s) {
+    const std::size_t n = valence_flip_sweep(mesh, f);
+    total += n;
+    if (n == 0) break;
+  }
+  return total;
+}
+
+}  // namespace remesh
