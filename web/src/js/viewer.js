@@ -41,6 +41,12 @@ export class Viewer {
     this.controls = new OrbitControls(this.camera, canvas);
     this.controls.addEventListener('change', () => this.render());
     this.controls.listenToKeyEvents(canvas);  // arrow keys pan when the canvas has focus
+    canvas.addEventListener('keydown', (e) => {
+      if (e.key === '+' || e.key === '=') this.zoom(0.8);
+      else if (e.key === '-') this.zoom(1.25);
+      else return;
+      e.preventDefault();
+    });
     new ResizeObserver(() => this.resize()).observe(canvas);
     new ResizeObserver(() => this.draw_histogram()).observe(hist);
   }
@@ -107,8 +113,7 @@ export class Viewer {
     const group = new THREE.Group();
     group.add(surface, edges);
     const slot = { name, label, geometry, edge_geometry, surface, edges, group, pairs, lengths, classed,
-      stats: length_stats(lengths), vertices: vertex_count, faces: mesh.triangles.length / 3,
-      polygons: mesh.polygons };
+      stats: length_stats(lengths), vertices: vertex_count, faces: mesh.triangles.length / 3 };
     this.slots.set(name, slot);
     this.reclassify(slot);
     return slot.stats;
@@ -180,13 +185,21 @@ export class Viewer {
     this.render();
   }
 
+  /// Moves the camera towards (factor < 1) or away from the orbit target.
+  zoom(factor) {
+    const offset = this.camera.position.clone().sub(this.controls.target).multiplyScalar(factor);
+    this.camera.position.copy(this.controls.target).add(offset);
+    this.controls.update();
+    this.render();
+  }
+
   update_status() {
     const s = this.current;
     if (!s) return;
     const c = s.counts;
-    const parts = [`${s.label}`, `${s.vertices.toLocaleString()} v`,
-      `${(s.polygons ?? s.faces).toLocaleString()} ${s.polygons ? 'polygons' : 'f'}`,
-      `${s.lengths.length.toLocaleString()} e`];
+    const parts = [`${s.label}`, `${s.vertices.toLocaleString()} v`];
+    if (s.classed) parts.push(`${s.faces.toLocaleString()} f`);  // the dual's triangles are a fan, not its faces
+    parts.push(`${s.lengths.length.toLocaleString()} e`);
     if (s.classed && c.short + c.long + c.inside && this.interval.emax > this.interval.emin)
       parts.push(`${c.short.toLocaleString()} short · ${c.long.toLocaleString()} long`);
     this.status.textContent = parts.join(' · ');
