@@ -3,6 +3,7 @@
 /// remeshing command `remesh IN OUT --emin A --emax B ...`.
 
 #include <cstdio>
+#include <filesystem>
 #include <iostream>
 #include <string>
 #include <vector>
@@ -70,6 +71,9 @@ int run(int argc, char** argv) {
   const std::string& first = args[0];
   if (first == "info" || first == "convert" || first == "dual")
     return dispatch(first, std::vector<std::string>(args.begin() + 1, args.end()));
+  // A bare word that is no file is a mistyped command rather than an input mesh.
+  if (first[0] != '-' && first.find_first_of("./") == std::string::npos && !std::filesystem::exists(first))
+    throw UsageError("unknown command '" + first + "'");
   return run_remesh(args);
 }
 

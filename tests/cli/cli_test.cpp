@@ -1,0 +1,293 @@
+/// \file cli_test.cpp
+/// The `remesh` executable as users run it: exit codes, one-line errors, and what it writes.
+
+#include <catch2/catch.hpp>
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+
+#include "run_process.h"
+#include "support/mesh_generators.h"
+
+namespace fs = std::filesystem;
+using remesh::TriMesh;
+using remesh::test::ProcessResult;
+
+namespace {
+
+ProcessResult remesh_cli(const std::vector<std::string>& args) { return remesh::test::run_process(REMESH_BIN, args); }
+
+/// A fresh directory for one test case, removed afterwards.
+struct TempDir {
+  fs::path path;
+  TempDir() {
+    char name[] = "/tmp/remesh_cli_test_XXXXXX";
+    path = mkdtemp(name);
+  }
+  ~TempDir() {
+    std::error_code ec;
+    fs::remove_all(path, ec);
+  }
+  std::string file(const std::string& name) const { return (path / name).string(); }
+};
+
+/// Writes OBJ by hand (not through the engine, which the tool itself uses).
+void write_obj(const TriMesh& m, const std::string& path) {
+  std::ofstream f(path);
+  f.precision(17);
+  for (auto v : m.vertices()) f << "v " << m.point(v)[0] << ' ' << m.point(v)[1] << ' ' << m.point(v)[2] << '\n';
+  for (auto face : m.faces()) {
+    f << 'f';
+    for (auto v : m.fv_range(face)) f << ' ' << v.idx() + 1;
+    f << '\n';
+  }
+}
+
+struct ObjCounts {
+  std::size_t vertices = 0, faces = 0;
+  std::vector<std::size_t> face_sizes;
+};
+
+ObjCounts count_obj(const std::string& path) {
+  std::ifstream f(path);
+  ObjCounts c;
+  std::string line;
+  while (std::getline(f, line)) {
+    std::istringstream s(line);
+    std::string tag;
+    s >> tag;
+    if (tag == "v") ++c.vertices;
+    if (tag == "f") {
+      ++c.faces;
+      std::size_t n = 0;
+      std::string idx;
+      while (s >> idx) ++n;
+      c.face_sizes.push_back(n);
+    }
+  }
+  return c;
+}
+
+std::size_t lines(const std::string& s) { return static_cast<std::size_t>(std::count(s.begin(), s.end(), '\n')); }
+
+std::string read_text(const std::string& path) {
+  std::ifstream f(path);
+  std::ostringstream s;
+  s << f.rdbuf();
+  return s.str();
+}
+
+nlohmann::json info_json(const std::string& path) {
+  const ProcessResult r = remesh_cli({"info", path, "--json"});
+  INFO(r.err);
+  REQUIRE(r.exit_code == 0);
+  return nlohmann::json::parse(r.out);
+}
+
+}  // namespace
+
+TEST_CASE("help and version", "[cli]") {
+  const ProcessResult top = remesh_cli({"--help"});
+  CHECK(top.exit_code == 0);
+  for (const char* command : {"info", "convert", "dual", "--emin"}) CHECK(top.out.find(command) != std::string::npos);
+  CHECK(remesh_cli({"--version"}).exit_code == 0);
+  CHECK(remesh_cli({}).exit_code == 2);
+  for (const char* command : {"info", "convert", "dual"}) {
+    const ProcessResult r = remesh_cli({command, "--help"});
+    CHECK(r.exit_code == 0);
+    CHECK(r.out.find(std::string("remesh ") + command) != std::string::npos);
+  }
+}
+
+TEST_CASE("bad arguments exit with 2 and one line on stderr", "[cli]") {
+  TempDir dir;
+  const std::string mesh = dir.file("sphere.obj");
+  write_obj(remesh::test::make_icosphere(1), mesh);
+  struct Case {
+    std::vector<std::string> args;
+    std::string mentions;
+  };
+  std::vector<Case> cases = {
+      {{"info", mesh, "--bogus"}, "--bogus"},
+      {{"info"}, "file"},
+      {{"info", dir.file("missing.obj")}, "missing.obj"},
+      {{"convert", mesh}, "file"},
+      {{"convert", mesh, dir.file("out.xyzzy")}, "out.xyzzy"},
+      {{"convert", mesh, dir.file("out.gltf")}, ".glb"},
+      {{"dual", dir.file("missing.obj"), dir.file("d.obj")}, "missing.obj"},
+      {{"frobnicate"}, "frobnicate"},
+  };
+#ifdef REMESH_CLI_HAS_REMESHER
+  const std::string out = dir.file("out.obj");
+  cases.push_back({{mesh, out, "--emax", "0.3"}, "--emin"});
+  cases.push_back({{mesh, out, "--emin", "0.3"}, "--emax"});
+  cases.push_back({{mesh, out, "--emin", "0.5", "--emax", "0.3"}, "--emax"});
+  cases.push_back({{mesh, out, "--emin", "abc", "--emax", "0.3"}, "--emin"});
+  cases.push_back({{mesh, out, "--emin", "0.2", "--emax", "0.3", "--rings", "9"}, "--rings"});
+  cases.push_back({{mesh, out, "--emin", "0.2", "--emax", "0.3", "--bogus", "1"}, "--bogus"});
+  cases.push_back({{dir.file("missing.obj"), out, "--emin", "0.2", "--emax", "0.3"}, "missing.obj"});
+  cases.push_back({{mesh, out, "--emin", "0.2", "--emax", "0.3", "--stats", dir.file("s.txt")}, "--stats"});
+#endif
+  for (const auto& c : cases) {
+    std::string joined;
+    for (const auto& a : c.args) joined += a + " ";
+    const ProcessResult r = remesh_cli(c.args);
+    INFO("remesh " << joined << "\nstderr: " << r.err);
+    CHECK(r.exit_code == 2);
+    CHECK(lines(r.err) == 1);
+    CHECK(r.err.find(c.mentions) != std::string::npos);
+  }
+  CHECK(!fs::exists(dir.file("out.obj")));
+}
+
+TEST_CASE("a bad input mesh exits with 3 and one line on stderr", "[cli]") {
+  TempDir dir;
+  std::vector<std::pair<std::string, std::string>> files = {
+      {"garbage.obj", "this is not\na mesh at all\n"},
+      {"garbage.ply", "ply\nformat nonsense 9.9\nend_header\n\x01\x02\x03"},
+      {"garbage.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n"},
+      {"empty.stl", ""},
+      {"bad_index.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 7\n"},
+  };
+  for (const auto& [name, content] : files) {
+    const std::string path = dir.file(name);
+    std::ofstream(path, std::ios::binary) << content;
+    for (const char* command : {"info", "convert", "dual"}) {
+      std::vector<std::string> args = {command, path};
+      if (std::string(command) != "info") args.push_back(dir.file("out.obj"));
+      const ProcessResult r = remesh_cli(args);
+      INFO(command << " " << name << "\nstderr: " << r.err);
+      CHECK(r.exit_code == 3);
+      CHECK(lines(r.err) == 1);
+    }
+  }
+}
+
+TEST_CASE("info --json has the counts of a generated mesh", "[cli]") {
+  TempDir dir;
+  const TriMesh sphere = remesh::test::make_icosphere(2);
+  const TriMesh grid = remesh::test::make_open_grid(6, 4, 1.0);
+  write_obj(sphere, dir.file("sphere.obj"));
+  write_obj(grid, dir.file("grid.obj"));
+
+  const auto s = info_json(dir.file("sphere.obj"));
+  CHECK(s.at("vertices") == sphere.n_vertices());
+  CHECK(s.at("faces") == sphere.n_faces());
+  CHECK(s.at("edges") == sphere.n_edges());
+  CHECK(s.at("components") == 1);
+  CHECK(s.at("boundary_loops") == 0);
+  CHECK(s.at("euler") == 2);
+  CHECK(s.at("repairs").empty());
+
+  const auto g = info_json(dir.file("grid.obj"));
+  CHECK(g.at("faces") == 6 * 4 * 2);
+  CHECK(g.at("vertices") == 7 * 5);
+  CHECK(g.at("boundary_loops") == 1);
+  CHECK(g.at("euler") == 1);
+
+  const ProcessResult text = remesh_cli({"info", dir.file("sphere.obj")});
+  CHECK(text.exit_code == 0);
+  CHECK(text.out.find(std::to_string(sphere.n_faces())) != std::string::npos);
+}
+
+TEST_CASE("info reports repairs: a quad mesh is triangulated", "[cli]") {
+  TempDir dir;
+  const std::string path = dir.file("quads.obj");
+  std::ofstream(path) << "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 2 0 0\nv 2 1 0\nf 1 2 3 4\nf 2 5 6 3\n";
+  const auto j = info_json(path);
+  CHECK(j.at("faces") == 4);
+  REQUIRE(!j.at("repairs").empty());
+  const ProcessResult text = remesh_cli({"info", path});
+  CHECK(text.out.find(j.at("repairs")[0].at("kind").get<std::string>()) != std::string::npos);
+}
+
+TEST_CASE("convert round trip obj -> ply -> obj keeps the counts", "[cli]") {
+  TempDir dir;
+  const TriMesh torus = remesh::test::make_torus(16, 8, 2.0, 0.5);
+  write_obj(torus, dir.file("torus.obj"));
+  for (const char* ext : {"ply", "off", "stl", "glb"}) {
+    const std::string mid = dir.file(std::string("torus.") + ext);
+    const std::string back = dir.file(std::string("back_") + ext + ".obj");
+    const std::vector<std::string> weld = std::string(ext) == "stl" ? std::vector<std::string>{"--weld"}
+                                                                    : std::vector<std::string>{};
+    std::vector<std::string> first = {"convert", dir.file("torus.obj"), mid};
+    std::vector<std::string> second = {"convert", mid, back};
+    second.insert(second.end(), weld.begin(), weld.end());
+    INFO(ext);
+    REQUIRE(remesh_cli(first).exit_code == 0);
+    const ProcessResult r = remesh_cli(second);
+    INFO(r.err);
+    REQUIRE(r.exit_code == 0);
+    const ObjCounts c = count_obj(back);
+    CHECK(c.vertices == torus.n_vertices());
+    CHECK(c.faces == torus.n_faces());
+    CHECK(info_json(back).at("euler") == 0);
+  }
+}
+
+TEST_CASE("dual writes one polygon per interior vertex", "[cli]") {
+  TempDir dir;
+  const TriMesh grid = remesh::test::make_hex_lattice_patch(7, 8, 1.0);
+  write_obj(grid, dir.file("lattice.obj"));
+  std::size_t interior = 0;
+  for (auto v : grid.vertices()) interior += grid.is_boundary(v) ? 0 : 1;
+  const ProcessResult r = remesh_cli({"dual", dir.file("lattice.obj"), dir.file("dual.obj")});
+  INFO(r.err);
+  REQUIRE(r.exit_code == 0);
+  const ObjCounts c = count_obj(dir.file("dual.obj"));
+  CHECK(c.faces == interior);
+  CHECK(c.vertices == grid.n_faces());
+  for (auto n : c.face_sizes) CHECK(n == 6);
+
+  REQUIRE(remesh_cli({"dual", dir.file("lattice.obj"), dir.file("dual.xyz")}).exit_code == 0);
+  CHECK(lines(read_text(dir.file("dual.xyz"))) >= grid.n_faces());
+  REQUIRE(remesh_cli({"dual", dir.file("lattice.obj"), dir.file("dual.glb")}).exit_code == 0);
+  CHECK(fs::file_size(dir.file("dual.glb")) > 0);
+}
+
+#ifdef REMESH_CLI_HAS_REMESHER
+TEST_CASE("a short remesh run writes the mesh, the dual and one stats row per iteration", "[cli]") {
+  TempDir dir;
+  write_obj(remesh::test::make_icosphere(2), dir.file("sphere.obj"));
+  const std::string out = dir.file("out.obj"), dual = dir.file("dual.obj");
+  const ProcessResult r = remesh_cli({dir.file("sphere.obj"), out, "--emin", "0.1", "--emax", "0.15", "--iterations",
+                                      "4", "--all-iterations", "--stats", dir.file("stats.csv"), "--dual", dual,
+                                      "--threads", "2"});
+  INFO(r.err);
+  REQUIRE(r.exit_code == 0);
+  CHECK(r.out.find("completed") != std::string::npos);
+  const auto j = info_json(out);
+  CHECK(j.at("euler") == 2);
+  CHECK(j.at("boundary_loops") == 0);
+  CHECK(j.at("faces") > 320);  // refined: the sphere's edges are longer than 0.15
+
+  const std::string csv = read_text(dir.file("stats.csv"));
+  std::istringstream rows(csv);
+  std::string header, line;
+  std::getline(rows, header);
+  CHECK(header.rfind("iteration,vertices,edges,mean,deviation,regular_percent,small,big,inside_fraction", 0) == 0);
+  int n = 0;
+  while (std::getline(rows, line)) {
+    ++n;
+    CHECK(line.rfind(std::to_string(n) + ",", 0) == 0);
+  }
+  CHECK(n == 4);
+
+  const ObjCounts d = count_obj(dual);
+  CHECK(d.vertices == j.at("faces").get<std::size_t>());
+  CHECK(d.faces == j.at("vertices").get<std::size_t>());
+
+  const ProcessResult quiet = remesh_cli({dir.file("sphere.obj"), out, "--emin", "0.1", "--emax", "0.15",
+                                          "--iterations", "2", "--quiet", "--stats", dir.file("stats.json")});
+  CHECK(quiet.exit_code == 0);
+  CHECK(quiet.out.empty());
+  const auto stats = nlohmann::json::parse(read_text(dir.file("stats.json")));
+  REQUIRE(stats.is_array());
+  REQUIRE(!stats.empty());
+  CHECK(stats.size() <= 2);
+  CHECK(stats.back().contains("max_projection_distance"));
+}
+#endif
