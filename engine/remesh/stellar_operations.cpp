@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <cstdlib>
 
 #include "remesh/geometry.h"
 #include "remesh/reposition.h"
@@ -146,6 +145,8 @@ VertexHandle apply_collapse(TriMesh& mesh, const CollapsePlan& plan, ComponentSi
   return kept;
 }
 
+double collapse_length_limit(double m_i, double sigma) { return std::max(m_i + sigma, 2.0 * (m_i - sigma)); }
+
 StellarCounts stellar_operations(TriMesh& mesh, const std::vector<unsigned>& list, double m_i, double sigma) {
   StellarCounts counts;
   ComponentSizes sizes(mesh);
@@ -169,8 +170,7 @@ StellarCounts stellar_operations(TriMesh& mesh, const std::vector<unsigned>& lis
       visit_star(v);
     } else if (length < m_i - sigma) {
       CollapsePlan plan;
-      static const double slack = getenv("RM_SLACK") ? atof(getenv("RM_SLACK")) : 0.0;
-      if (!plan_collapse(mesh, e, m_i, m_i + sigma + slack, sizes, plan)) continue;
+      if (!plan_collapse(mesh, e, m_i, collapse_length_limit(m_i, sigma), sizes, plan)) continue;
       visit_star(apply_collapse(mesh, plan, sizes));
       ++counts.collapses;
     }
