@@ -139,6 +139,10 @@ int run_remesh(const std::vector<std::string>& args) {
     return 0;
   }
   const Job job = parse_job(args);
+  // From here on Ctrl-C asks for a stop (and no longer kills the program before the mesh is
+  // written); one during reading makes equalize() return at once with the input as it was.
+  std::stop_source stop;
+  const InterruptGuard guard(stop);
   LoadedMesh loaded = read_mesh_file(job.in, job.read);
   if (!job.quiet) print_repairs(std::cerr, loaded.repairs);
   std::optional<ReferenceSurface> reference;
@@ -147,18 +151,13 @@ int run_remesh(const std::vector<std::string>& args) {
   TriMesh& mesh = loaded.mesh;
   std::vector<IterationStats> rows;
   Progress progress(job.params.iterations, job.quiet);
-  std::stop_source stop;
-  Result result;
-  {
-    InterruptGuard guard(stop);
-    result = equalize(
-        mesh, job.params,
-        [&](const IterationStats& row) {
-          rows.push_back(row);
-          progress.update(row);
-        },
-        stop.get_token());
-  }
+  const Result result = equalize(
+      mesh, job.params,
+      [&](const IterationStats& row) {
+        rows.push_back(row);
+        progress.update(row);
+      },
+      stop.get_token());
   progress.finish();
 
   write_mesh_file(to_soup(mesh), job.out);

@@ -290,4 +290,41 @@ TEST_CASE("a short remesh run writes the mesh, the dual and one stats row per it
   CHECK(stats.size() <= 2);
   CHECK(stats.back().contains("max_projection_distance"));
 }
+
+TEST_CASE("a job over --max-faces is refused with exit 3", "[cli]") {
+  TempDir dir;
+  write_obj(remesh::test::make_icosphere(2), dir.file("sphere.obj"));
+  // The input has 320 faces: over a limit of 100 already.
+  ProcessResult r = remesh_cli({dir.file("sphere.obj"), dir.file("out.obj"), "--emin", "0.2", "--emax", "0.3",
+                                "--max-faces", "100"});
+  CHECK(r.exit_code == 3);
+  CHECK(lines(r.err) == 1);
+  // Edges of 0.001-0.002 on the unit sphere would need millions of faces.
+  r = remesh_cli({dir.file("sphere.obj"), dir.file("out.obj"), "--emin", "0.001", "--emax", "0.002", "--max-faces",
+                  "100000"});
+  CHECK(r.exit_code == 3);
+  CHECK(lines(r.err) == 1);
+  CHECK(!fs::exists(dir.file("out.obj")));
+}
+
+TEST_CASE("Ctrl-C stops the run and the partial mesh is still written", "[cli]") {
+  TempDir dir;
+  write_obj(remesh::test::make_icosphere(3), dir.file("sphere.obj"));
+  const std::string out = dir.file("out.obj");
+  // 1000 iterations that never converge (the interval is narrow) would take far longer than the
+  // 400 ms after which SIGINT arrives.
+  const ProcessResult r = remesh::test::run_process(
+      REMESH_BIN,
+      {dir.file("sphere.obj"), out, "--emin", "0.05", "--emax", "0.0505", "--iterations", "1000", "--all-iterations",
+       "--stats", dir.file("stats.json"), "--threads", "1"},
+      400);
+  INFO(r.err);
+  CHECK(r.exit_code == 1);
+  CHECK(r.err.find("cancelled") != std::string::npos);
+  CHECK(r.out.find("cancelled") != std::string::npos);
+  const auto j = info_json(out);
+  CHECK(j.at("euler") == 2);
+  const auto stats = nlohmann::json::parse(read_text(dir.file("stats.json")));
+  CHECK(stats.size() < 1000);
+}
 #endif

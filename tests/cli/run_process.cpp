@@ -5,7 +5,10 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <chrono>
+#include <csignal>
 #include <cstdio>
+#include <thread>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -23,7 +26,8 @@ std::string slurp(const std::filesystem::path& p) {
 
 }  // namespace
 
-ProcessResult run_process(const std::string& program, const std::vector<std::string>& args) {
+ProcessResult run_process(const std::string& program, const std::vector<std::string>& args,
+                          int interrupt_after_ms) {
   // Output goes to temporary files: no pipe can fill up and block the child.
   char out_name[] = "/tmp/remesh_cli_out_XXXXXX";
   char err_name[] = "/tmp/remesh_cli_err_XXXXXX";
@@ -45,6 +49,10 @@ ProcessResult run_process(const std::string& program, const std::vector<std::str
     if (null_fd >= 0) dup2(null_fd, STDIN_FILENO);
     execv(program.c_str(), argv.data());
     _exit(127);
+  }
+  if (interrupt_after_ms > 0) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(interrupt_after_ms));
+    kill(pid, SIGINT);
   }
   int status = 0;
   waitpid(pid, &status, 0);

@@ -13,6 +13,8 @@ struct ProcessResult {
 };
 
 /// Runs `program` with `args` (no shell), waits for it, returns what it printed.
-ProcessResult run_process(const std::string& program, const std::vector<std::string>& args);
+/// If `interrupt_after_ms` > 0, sends SIGINT to the child after that many milliseconds.
+ProcessResult run_process(const std::string& program, const std::vector<std::string>& args,
+                          int interrupt_after_ms = 0);
 
 }  // namespace remesh::test

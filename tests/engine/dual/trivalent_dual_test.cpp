@@ -214,3 +214,32 @@ TEST_CASE("dual of a mesh with deleted elements matches the dual of its compacte
   REQUIRE(a.n_faces() == b.n_faces());
   for (auto v : a.vertices()) CHECK((a.point(v) - b.point(v)).norm() == 0);
 }
+
+#ifdef REMESH_DUAL_TEST_PROJECTION
+#include "remesh/reference_surface.h"
+
+TEST_CASE("projected dual vertices lie on the reference surface", "[dual]") {
+  // Centroids of a coarse sphere's triangles lie inside the unit sphere; projected onto a fine
+  // unit sphere they move out to (nearly) radius 1. Connectivity does not change.
+  const TriMesh coarse = make_icosphere(1);
+  const ReferenceSurface fine(make_icosphere(4));
+  const PolyMesh plain = trivalent_dual(coarse);
+  const PolyMesh projected = trivalent_dual(coarse, &fine);
+  REQUIRE(projected.n_vertices() == plain.n_vertices());
+  REQUIRE(projected.n_faces() == plain.n_faces());
+  REQUIRE(projected.n_edges() == plain.n_edges());
+  double worst_plain = 0, worst_projected = 0;
+  for (auto v : projected.vertices()) {
+    worst_plain = std::max(worst_plain, std::abs(plain.point(v).norm() - 1.0));
+    worst_projected = std::max(worst_projected, std::abs(projected.point(v).norm() - 1.0));
+  }
+  CHECK(worst_plain > 0.05);
+  CHECK(worst_projected < 0.01);  // a level-4 icosphere deviates from the sphere by < 0.005
+  check_face_orientation(coarse, projected);
+
+  // Projected onto the primal itself, a centroid stays where it is.
+  const ReferenceSurface self(coarse);
+  const PolyMesh onto_self = trivalent_dual(coarse, &self);
+  for (auto v : onto_self.vertices()) CHECK((onto_self.point(v) - plain.point(v)).norm() < 1e-9);
+}
+#endif
