@@ -21,7 +21,7 @@ int run_remesh(const std::vector<std::string>& args);
 /// Throws UsageError unless `path` names an existing regular file.
 void require_input_file(const std::string& path);
 /// The format to write `path` in, from its extension. Throws UsageError for an unknown extension
-/// and for .gltf (only the binary .glb is written).
+/// and for .gltf (only the binary .glb is written), and when the directory of `path` does not exist.
 Format require_output_format(const std::string& path);
 /// One line per repair ("  kind (count): detail"); nothing when there were none.
 void print_repairs(std::ostream& out, const std::vector<Repair>& repairs);

@@ -24,6 +24,11 @@ Format require_output_format(const std::string& path) {
   if (*format == Format::Gltf)
     throw UsageError("writing text glTF is not supported: name the output .glb (binary glTF) instead of '" +
                      path + "'");
+  // Checked now, not after a long run: the directory the output goes to must exist.
+  const auto dir = std::filesystem::path(path).parent_path();
+  std::error_code ec;
+  if (!dir.empty() && !std::filesystem::is_directory(dir, ec))
+    throw UsageError("output directory does not exist: " + dir.string());
   return *format;
 }
 

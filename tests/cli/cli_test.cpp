@@ -117,6 +117,7 @@ TEST_CASE("bad arguments exit with 2 and one line on stderr", "[cli]") {
       {{"convert", mesh}, "file"},
       {{"convert", mesh, dir.file("out.xyzzy")}, "out.xyzzy"},
       {{"convert", mesh, dir.file("out.gltf")}, ".glb"},
+      {{"convert", mesh, dir.file("no_such_dir/out.obj")}, "no_such_dir"},
       {{"dual", dir.file("missing.obj"), dir.file("d.obj")}, "missing.obj"},
       {{"frobnicate"}, "frobnicate"},
   };
