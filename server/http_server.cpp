@@ -1,0 +1,620 @@
+#include "http_server.h"
+
+#include <httplib.h>
+
+#include <atomic>
+#include <charconv>
+#include <cmath>
+#include <chrono>
+#include <regex>
+
+#include "api/json_codec.h"
+#include "api/problem.h"
+#include "api/upload.h"
+#include "io/mesh_io.h"
+#include "routes.h"
+#include "sse.h"
+#include "static_files.h"
+
+namespace remeshd {
+
+using nlohmann::json;
+using remesh::FieldError;
+using remesh::api::JobRecord;
+using remesh::api::JobState;
+using remesh::api::Problem;
+using remesh::api::make_problem;
+
+namespace {
+
+constexpr const char* kPrefix = "/api/v1";
+constexpr std::size_t kMiB = 1024 * 1024;
+constexpr std::size_t kMaxParamsBytes = 64 * 1024;
+/// How much of an over-limit upload is read (and dropped) so the client can read the 413; beyond
+/// it the connection is closed.
+constexpr std::size_t kDrainBytes = 64 * kMiB;
+
+thread_local std::chrono::steady_clock::time_point t_request_start;
+
+double seconds_since(std::chrono::steady_clock::time_point t) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
+}
+
+void send_json(httplib::Response& res, int status, const json& body) {
+  res.status = status;
+  res.set_content(body.dump(-1, ' ', false, json::error_handler_t::replace), "application/json");
+}
+
+void send_problem(httplib::Response& res, const Problem& p) {
+  res.status = p.status;
+  res.set_content(p.body.dump(-1, ' ', false, json::error_handler_t::replace), "application/problem+json");
+}
+
+void send_problem(httplib::Response& res, int status, const std::string& detail,
+                  const std::vector<FieldError>& errors = {}) {
+  send_problem(res, make_problem(status, detail, errors));
+}
+
+bool constant_time_equal(const std::string& a, const std::string& b) {
+  if (a.size() != b.size()) return false;
+  unsigned char diff = 0;
+  for (std::size_t i = 0; i < a.size(); ++i) diff |= static_cast<unsigned char>(a[i] ^ b[i]);
+  return diff == 0;
+}
+
+/// Query parameters as a map (first value of each), minus the ones that are not job parameters.
+std::map<std::string, std::string> query_params(const httplib::Request& req) {
+  std::map<std::string, std::string> out;
+  for (const auto& [k, v] : req.params) out.emplace(k, v);
+  return out;
+}
+
+}  // namespace
+
+struct HttpServer::Impl {
+  Options options;
+  JobManager& jobs;
+  Metrics& metrics;
+  Logger& log;
+  std::filesystem::path web_root;
+  httplib::Server server;
+  std::atomic<std::size_t> streams{0};
+  std::vector<std::pair<std::regex, std::string>> route_labels;
+  std::chrono::steady_clock::time_point started = std::chrono::steady_clock::now();
+
+  Impl(const Options& o, JobManager& j, Metrics& m, Logger& l, std::filesystem::path root)
+      : options(o), jobs(j), metrics(m), log(l), web_root(std::move(root)) {}
+
+  using Handler = std::function<void(const httplib::Request&, httplib::Response&)>;
+
+  /// Handlers never throw: anything escaping becomes a 500 problem.
+  Handler guard(Handler h) {
+    return [this, h = std::move(h)](const httplib::Request& req, httplib::Response& res) {
+      try {
+        h(req, res);
+      } catch (const std::exception& e) {
+        log.error("handler", {str("path", req.path), str("error", e.what())});
+        send_problem(res, 500, std::string("internal error: ") + e.what());
+      } catch (...) {
+        send_problem(res, 500, "internal error");
+      }
+    };
+  }
+
+  std::string route_label(const httplib::Request& req) const {
+    for (const auto& [re, label] : route_labels)
+      if (std::regex_match(req.path, re)) return label;
+    if (req.path.rfind("/api/", 0) == 0) return "unmatched";
+    return "static";
+  }
+
+  void setup();
+  void cors_headers(httplib::Response& res) const;
+  bool authorized(const httplib::Request& req) const;
+  void post_job(const httplib::Request& req, httplib::Response& res, const httplib::ContentReader& reader);
+  void get_job(const httplib::Request& req, httplib::Response& res);
+  void list_jobs(const httplib::Request& req, httplib::Response& res);
+  void delete_job(const httplib::Request& req, httplib::Response& res);
+  void events(const httplib::Request& req, httplib::Response& res);
+  void result(const httplib::Request& req, httplib::Response& res);
+  void stats(const httplib::Request& req, httplib::Response& res);
+  void health(const httplib::Request& req, httplib::Response& res);
+  void static_files(const httplib::Request& req, httplib::Response& res);
+  /// The job named by the first path parameter, or a 404 answer.
+  std::optional<JobRecord> find_job(const httplib::Request& req, httplib::Response& res);
+  json document(const JobRecord& r) const { return remesh::api::job_to_json(r, kPrefix, remesh::api::now_seconds()); }
+};
+
+void HttpServer::Impl::cors_headers(httplib::Response& res) const {
+  if (options.cors_origin.empty()) return;
+  res.set_header("Access-Control-Allow-Origin", options.cors_origin);
+  if (options.cors_origin != "*") res.set_header("Vary", "Origin");
+  res.set_header("Access-Control-Expose-Headers", "Location, ETag, Content-Disposition, Retry-After");
+}
+
+bool HttpServer::Impl::authorized(const httplib::Request& req) const {
+  if (options.token.empty()) return true;
+  std::string auth = req.get_header_value("Authorization");
+  if (auth.rfind("Bearer ", 0) == 0 && constant_time_equal(auth.substr(7), options.token)) return true;
+  // EventSource and download links cannot set headers: the token may come as a query parameter.
+  if (req.has_param("access_token") && constant_time_equal(req.get_param_value("access_token"), options.token))
+    return true;
+  return false;
+}
+
+void HttpServer::Impl::setup() {
+  unsigned threads = options.http_threads ? options.http_threads : options.max_streams + 16;
+  server.new_task_queue = [threads] { return new httplib::ThreadPool(threads); };
+  server.set_payload_max_length(options.max_upload_mb * kMiB + kMiB);  // Content-Length; chunked counted below
+  server.set_keep_alive_timeout(5);
+  server.set_read_timeout(30);
+  server.set_write_timeout(30);
+
+  for (const RouteSpec& r : kRoutes)
+    route_labels.emplace_back(std::regex(route_pattern(r.path)), r.path);
+
+  server.set_pre_routing_handler([this](const httplib::Request& req, httplib::Response& res) {
+    t_request_start = std::chrono::steady_clock::now();
+    if (req.method == "OPTIONS" && !options.cors_origin.empty()) {
+      res.status = 204;
+      res.set_header("Access-Control-Allow-Methods", "GET, POST, DELETE, OPTIONS");
+      res.set_header("Access-Control-Allow-Headers", "Authorization, Content-Type, Last-Event-ID");
+      res.set_header("Access-Control-Max-Age", "600");
+      return httplib::Server::HandlerResponse::Handled;
+    }
+    if (req.path.rfind("/api/", 0) == 0 && !authorized(req)) {
+      res.set_header("WWW-Authenticate", "Bearer realm=\"remeshd\"");
+      send_problem(res, 401, "this server requires 'Authorization: Bearer <token>'");
+      return httplib::Server::HandlerResponse::Handled;
+    }
+    return httplib::Server::HandlerResponse::Unhandled;
+  });
+  server.set_post_routing_handler([this](const httplib::Request&, httplib::Response& res) {
+    cors_headers(res);
+    res.set_header("X-Content-Type-Options", "nosniff");
+  });
+  server.set_error_handler(httplib::Server::HandlerWithResponse([](const httplib::Request& req,
+                                                                   httplib::Response& res) {
+    if (!res.body.empty() || res.content_length_ > 0) return httplib::Server::HandlerResponse::Unhandled;
+    std::string detail;
+    switch (res.status) {
+      case 404: detail = "no such route: " + req.method + " " + req.path; break;
+      case 413: detail = "the request body is too large"; break;
+      case 400:
+        detail = "malformed request";
+        if (req.get_header_value("Content-Type").find("multipart/form-data") != std::string::npos)
+          detail += " (multipart/form-data: nothing may follow the boundary parameter, e.g. no '; charset=')";
+        break;
+      default: detail = remesh::api::status_title(res.status);
+    }
+    send_problem(res, make_problem(res.status, detail));
+    return httplib::Server::HandlerResponse::Handled;
+  }));
+  server.set_exception_handler([this](const httplib::Request& req, httplib::Response& res, std::exception_ptr ep) {
+    std::string what = "unknown exception";
+    try {
+      if (ep) std::rethrow_exception(ep);
+    } catch (const std::exception& e) {
+      what = e.what();
+    } catch (...) {
+    }
+    log.error("handler", {str("path", req.path), str("error", what)});
+    send_problem(res, 500, "internal error: " + what);
+  });
+  server.set_logger([this](const httplib::Request& req, const httplib::Response& res) {
+    double secs = seconds_since(t_request_start);
+    std::string route = route_label(req);
+    metrics.observe_request(req.method, route, res.status, secs);
+    log.info("request", {str("method", req.method), str("path", req.path), str("route", route),
+                         num("status", res.status), num("ms", std::round(secs * 1e5) / 100),
+                         num("bytes", static_cast<double>(res.body.size())), str("remote", req.remote_addr)});
+  });
+
+  const std::string jobs_path = std::string(kPrefix) + "/jobs";
+  const std::string job_path = jobs_path + "/([^/]+)";
+  server.Get("/healthz", guard([this](const auto& req, auto& res) { health(req, res); }));
+  server.Get("/metrics", guard([this](const auto&, auto& res) {
+               Gauges g = jobs.gauges();
+               g.open_streams = streams.load();
+               res.set_content(metrics.render(g), "text/plain; version=0.0.4; charset=utf-8");
+             }));
+  server.Get(std::string(kPrefix) + "/openapi\\.yaml",
+             guard([](const auto&, auto& res) { res.set_content(openapi_yaml(), "application/yaml"); }));
+  server.Post(jobs_path, [this](const httplib::Request& req, httplib::Response& res,
+                                const httplib::ContentReader& reader) {
+    try {
+      post_job(req, res, reader);
+    } catch (const std::exception& e) {
+      log.error("handler", {str("path", req.path), str("error", e.what())});
+      send_problem(res, 500, std::string("internal error: ") + e.what());
+    } catch (...) {
+      send_problem(res, 500, "internal error");
+    }
+  });
+  server.Get(jobs_path, guard([this](const auto& req, auto& res) { list_jobs(req, res); }));
+  server.Get(job_path, guard([this](const auto& req, auto& res) { get_job(req, res); }));
+  server.Delete(job_path, guard([this](const auto& req, auto& res) { delete_job(req, res); }));
+  server.Get(job_path + "/events", guard([this](const auto& req, auto& res) { events(req, res); }));
+  server.Get(job_path + "/result", guard([this](const auto& req, auto& res) { result(req, res); }));
+  server.Get(job_path + "/stats", guard([this](const auto& req, auto& res) { stats(req, res); }));
+  server.Get("/.*", guard([this](const auto& req, auto& res) { static_files(req, res); }));
+}
+
+void HttpServer::Impl::health(const httplib::Request&, httplib::Response& res) {
+  Gauges g = jobs.gauges();
+  std::size_t total = 0;
+  for (const auto& [s, n] : g.jobs_by_state) total += n;
+  send_json(res, 200,
+            {{"status", "ok"},
+             {"version", REMESHD_VERSION},
+             {"uptime_seconds", seconds_since(started)},
+             {"workers", g.workers},
+             {"busy_workers", g.busy_workers},
+             {"queue_depth", g.queue_depth},
+             {"jobs", total},
+             {"event_streams", streams.load()}});
+}
+
+std::optional<JobRecord> HttpServer::Impl::find_job(const httplib::Request& req, httplib::Response& res) {
+  std::string id = req.matches.size() > 1 ? req.matches[1].str() : "";
+  std::optional<JobRecord> rec;
+  if (remesh::api::is_valid_job_id(id)) rec = jobs.record(id);
+  if (!rec) send_problem(res, 404, "no job with id '" + id.substr(0, 64) + "'");
+  return rec;
+}
+
+void HttpServer::Impl::post_job(const httplib::Request& req, httplib::Response& res,
+                                const httplib::ContentReader& reader) {
+  const std::size_t limit = options.max_upload_mb * kMiB;
+  std::string body, params_text, filename, part_type, part;
+  bool got_mesh = false, got_params = false, too_big = false, params_too_big = false;
+  std::size_t total = 0;
+  auto count = [&](std::size_t n) {
+    total += n;
+    if (total > limit && !too_big) {
+      too_big = true;
+      std::string().swap(body);  // nothing of an over-limit upload is kept
+    }
+    return total <= limit + kDrainBytes;  // past this, stop reading and close
+  };
+  bool ok;
+  if (req.is_multipart_form_data()) {
+    ok = reader(
+        [&](const httplib::MultipartFormData& header) {
+          part = header.name;
+          if (part == "mesh") {
+            got_mesh = true;
+            filename = header.filename;
+            part_type = header.content_type;
+          } else if (part == "params") {
+            got_params = true;
+          }
+          return true;
+        },
+        [&](const char* data, std::size_t n) {
+          if (!count(n)) return false;
+          if (too_big) return true;
+          if (part == "mesh") body.append(data, n);
+          else if (part == "params") {
+            if (params_text.size() + n > kMaxParamsBytes) params_too_big = true;
+            else params_text.append(data, n);
+          }
+          return true;
+        });
+  } else {
+    ok = reader([&](const char* data, std::size_t n) {
+      if (!count(n)) return false;
+      if (!too_big) body.append(data, n);
+      return true;
+    });
+    filename = req.get_param_value("filename");
+    part_type = req.get_header_value("Content-Type");
+  }
+  if (too_big || res.status == 413) {
+    send_problem(res, 413, "the upload is larger than the limit of " + std::to_string(options.max_upload_mb) + " MiB");
+    if (!ok) res.set_header("Connection", "close");
+    return;
+  }
+  if (!ok) {
+    send_problem(res, 400, "the request body could not be read (malformed or interrupted upload)");
+    return;
+  }
+
+  std::vector<FieldError> errors;
+  remesh::ParsedParams parsed;
+  if (got_params) {
+    json j = json::parse(params_text, nullptr, false);
+    if (params_too_big) errors.push_back({"params", "is larger than 64 KiB"});
+    else if (j.is_discarded()) errors.push_back({"params", "is not valid JSON"});
+    else parsed = remesh::params_from_json(j);
+  } else {
+    parsed = remesh::params_from_query(query_params(req), {"format", "filename", "access_token"});
+  }
+  if (req.is_multipart_form_data() && !got_mesh) errors.push_back({"mesh", "is required (a file field named 'mesh')"});
+  else if (body.empty()) errors.push_back({"mesh", "is empty"});
+  auto format = remesh::api::resolve_format(req.get_param_value("format"), filename, part_type, errors);
+  for (const FieldError& e : remesh::validate_params(parsed, options.max_iterations)) errors.push_back(e);
+  if (!errors.empty()) {
+    send_problem(res, 422, "invalid request: see errors", errors);
+    return;
+  }
+  if (filename.empty()) filename = "mesh" + (format ? "." + std::string(remesh::format_name(*format)) : std::string());
+
+  remesh::api::UploadLimits limits;
+  limits.max_faces = options.max_faces;
+  limits.max_iterations = options.max_iterations;
+  limits.max_output_faces = options.max_output_faces;
+  std::optional<remesh::api::PreparedJob> prepared;
+  try {
+    prepared.emplace(remesh::api::prepare_job(body, filename, format, parsed, limits));
+  } catch (const remesh::ParamsError& e) {
+    send_problem(res, remesh::api::problem_from_exception(e));
+    return;
+  } catch (const remesh::MeshError& e) {
+    send_problem(res, remesh::api::problem_from_exception(e));
+    return;
+  } catch (const remesh::LimitError& e) {
+    send_problem(res, remesh::api::problem_from_exception(e));
+    return;
+  }
+  JobRecord& record = prepared->record;
+  switch (jobs.submit(record, body)) {
+    case JobManager::Submit::QueueFull:
+      res.set_header("Retry-After", "10");
+      send_problem(res, 503, "the job queue is full (" + std::to_string(options.queue_size) + " jobs); try again later");
+      return;
+    case JobManager::Submit::ShuttingDown:
+      res.set_header("Retry-After", "5");
+      send_problem(res, 503, "the server is shutting down");
+      return;
+    case JobManager::Submit::Accepted: break;
+  }
+  std::string location = std::string(kPrefix) + "/jobs/" + record.id;
+  res.set_header("Location", location);
+  auto current = jobs.record(record.id);
+  send_json(res, 202, document(current ? *current : record));
+}
+
+void HttpServer::Impl::get_job(const httplib::Request& req, httplib::Response& res) {
+  if (auto rec = find_job(req, res)) send_json(res, 200, document(*rec));
+}
+
+void HttpServer::Impl::list_jobs(const httplib::Request& req, httplib::Response& res) {
+  std::vector<FieldError> errors;
+  std::optional<JobState> state;
+  if (req.has_param("state") && !req.get_param_value("state").empty()) {
+    state = remesh::api::parse_state(req.get_param_value("state"));
+    if (!state) errors.push_back({"state", "must be one of queued, running, succeeded, failed, cancelling, cancelled"});
+  }
+  auto number = [&](const char* name, std::size_t fallback, std::size_t max) -> std::size_t {
+    if (!req.has_param(name)) return fallback;
+    std::string v = req.get_param_value(name);
+    std::size_t n = 0;
+    auto [p, ec] = std::from_chars(v.data(), v.data() + v.size(), n);
+    if (v.empty() || ec != std::errc() || p != v.data() + v.size() || n > max) {
+      errors.push_back({name, "must be an integer 0.." + std::to_string(max)});
+      return fallback;
+    }
+    return n;
+  };
+  std::size_t limit = number("limit", 50, 1000);
+  std::size_t offset = number("offset", 0, 1'000'000'000);
+  if (!errors.empty()) {
+    send_problem(res, 422, "invalid query: see errors", errors);
+    return;
+  }
+  JobManager::Page page = jobs.list(state, limit, offset);
+  json list = json::array();
+  for (const JobRecord& r : page.jobs) list.push_back(document(r));
+  send_json(res, 200, {{"jobs", list}, {"total", page.total}, {"limit", limit}, {"offset", offset}});
+}
+
+void HttpServer::Impl::delete_job(const httplib::Request& req, httplib::Response& res) {
+  std::string id = req.matches[1].str();
+  JobRecord after;
+  auto outcome = remesh::api::is_valid_job_id(id) ? jobs.cancel(id, &after) : JobManager::Cancel::NotFound;
+  switch (outcome) {
+    case JobManager::Cancel::NotFound: send_problem(res, 404, "no job with id '" + id.substr(0, 64) + "'"); return;
+    case JobManager::Cancel::Removed: res.status = 204; return;
+    case JobManager::Cancel::Accepted: send_json(res, 202, document(after)); return;
+  }
+}
+
+void HttpServer::Impl::events(const httplib::Request& req, httplib::Response& res) {
+  auto rec = find_job(req, res);
+  if (!rec) return;
+  std::size_t open = ++streams;
+  if (open > options.max_streams) {
+    --streams;
+    res.set_header("Retry-After", "5");
+    send_problem(res, 503, "too many open event streams (" + std::to_string(options.max_streams) + "); retry later");
+    return;
+  }
+  std::string last = req.get_header_value("Last-Event-ID");
+  if (last.empty()) last = req.get_param_value("lastEventId");
+  std::optional<JobState> state_before;
+  auto cursor = jobs.start_cursor(rec->id, parse_last_event_id(last), state_before);
+  if (!cursor) {
+    --streams;
+    send_problem(res, 404, "no job with id '" + rec->id + "'");
+    return;
+  }
+  struct Stream {
+    std::string id;
+    std::size_t cursor;
+    std::optional<JobState> state_before;
+    bool started = false;
+    std::chrono::steady_clock::time_point deadline;
+  };
+  auto stream = std::make_shared<Stream>(Stream{rec->id, *cursor, state_before, false,
+                                                std::chrono::steady_clock::now() +
+                                                    std::chrono::milliseconds(static_cast<long long>(
+                                                        options.stream_lifetime_seconds * 1000))});
+  res.set_header("Cache-Control", "no-cache");
+  res.set_header("X-Accel-Buffering", "no");
+  double heartbeat = options.heartbeat_seconds;
+  res.set_chunked_content_provider(
+      "text/event-stream",
+      [this, stream, heartbeat](std::size_t, httplib::DataSink& sink) {
+        if (!sink.is_writable()) return false;  // the client left (0.11.4 would spin otherwise)
+        std::string out;
+        if (!stream->started) {
+          stream->started = true;
+          out += sse_retry(3000);
+          if (stream->state_before) out += sse_state(*stream->state_before);
+        }
+        double left = std::chrono::duration<double>(stream->deadline - std::chrono::steady_clock::now()).count();
+        JobManager::Batch batch = jobs.poll(stream->id, stream->cursor, std::max(0.0, std::min(heartbeat, left)));
+        if (!batch.found) {  // removed while streaming
+          out += sse_comment("job removed");
+          sink.write(out.data(), out.size());
+          sink.done();
+          return true;
+        }
+        for (std::size_t i = 0; i < batch.events.size(); ++i)
+          out += batch.events[i].kind == JobEvent::Kind::State ? sse_state(batch.events[i].state)
+                                                               : sse_iteration(batch.rows[i]);
+        stream->cursor = batch.cursor;
+        bool finish = false;
+        if (batch.ended) {
+          out += sse_end(batch.state);
+          finish = true;
+        } else if (batch.shutting_down) {
+          out += sse_comment("server shutting down") + sse_retry(2000);
+          finish = true;
+        } else if (std::chrono::steady_clock::now() >= stream->deadline) {
+          out += sse_comment("stream lifetime reached; reconnect with Last-Event-ID") + sse_retry(1000);
+          finish = true;
+        } else if (out.empty()) {
+          out = sse_comment("ping");
+        }
+        if (!sink.write(out.data(), out.size())) return false;
+        if (finish) sink.done();
+        return true;
+      },
+      [this](bool) { --streams; });
+}
+
+void HttpServer::Impl::result(const httplib::Request& req, httplib::Response& res) {
+  auto rec = find_job(req, res);
+  if (!rec) return;
+  std::string mesh = req.has_param("mesh") ? req.get_param_value("mesh") : "remeshed";
+  std::string format = req.has_param("format") ? req.get_param_value("format") : "obj";
+  std::vector<FieldError> errors;
+  const std::vector<std::string>* formats = nullptr;
+  if (mesh == "remeshed" || mesh == "input") formats = &remesh::api::remeshed_formats();
+  else if (mesh == "dual") formats = &remesh::api::dual_formats();
+  else errors.push_back({"mesh", "must be remeshed, dual or input"});
+  if (formats && std::find(formats->begin(), formats->end(), format) == formats->end()) {
+    std::string allowed;
+    for (const auto& f : *formats) allowed += (allowed.empty() ? "" : ", ") + f;
+    errors.push_back({"format", "must be one of " + allowed + " for mesh=" + mesh});
+  }
+  if (!errors.empty()) {
+    send_problem(res, 422, "invalid query: see errors", errors);
+    return;
+  }
+  if (mesh != "input" && rec->state != JobState::Succeeded) {
+    Problem p = make_problem(409, "the job is " + std::string(remesh::api::state_name(rec->state)) +
+                                      "; results exist only when it succeeded");
+    p.body["state"] = remesh::api::state_name(rec->state);
+    if (rec->error) p.body["error"] = *rec->error;
+    send_problem(res, p);
+    return;
+  }
+  std::filesystem::path path;
+  try {
+    path = jobs.file(rec->id, mesh + "." + format);
+  } catch (const std::exception& e) {
+    send_problem(res, 500, std::string("cannot produce the file: ") + e.what());
+    return;
+  }
+  std::error_code ec;
+  auto size = std::filesystem::file_size(path, ec);
+  if (ec) {
+    send_problem(res, 404, "the file is gone (the job was removed)");
+    return;
+  }
+  std::string etag = "\"" + rec->id + "-" + mesh + "-" + format + "-" + std::to_string(size) + "\"";
+  res.set_header("ETag", etag);
+  res.set_header("Cache-Control", "private, no-cache");
+  std::string inm = req.get_header_value("If-None-Match");
+  if (!inm.empty() && (inm == "*" || inm.find(etag) != std::string::npos)) {
+    res.status = 304;
+    return;
+  }
+  std::string bytes = read_file(path);
+  std::string name = remesh::api::safe_stem(rec->filename) + "-" + mesh + "." + format;
+  res.set_header("Content-Disposition", "attachment; filename=\"" + name + "\"");
+  auto f = remesh::parse_format(format);
+  res.status = 200;
+  res.set_content(std::move(bytes), f ? std::string(remesh::mime_type(*f)) : "application/octet-stream");
+}
+
+void HttpServer::Impl::stats(const httplib::Request& req, httplib::Response& res) {
+  auto rec = find_job(req, res);
+  if (!rec) return;
+  std::string format = req.has_param("format") ? req.get_param_value("format") : "json";
+  if (format != "json" && format != "csv") {
+    send_problem(res, 422, "invalid query: see errors", {{"format", "must be json or csv"}});
+    return;
+  }
+  auto rows = jobs.rows(rec->id);
+  if (!rows) {
+    send_problem(res, 404, "no job with id '" + rec->id + "'");
+    return;
+  }
+  if (format == "csv") {
+    res.set_header("Content-Disposition",
+                   "inline; filename=\"" + remesh::api::safe_stem(rec->filename) + "-stats.csv\"");
+    res.set_content(remesh::stats_to_csv(*rows), "text/csv; charset=utf-8");
+    return;
+  }
+  send_json(res, 200, {{"rows", *rows}});
+}
+
+void HttpServer::Impl::static_files(const httplib::Request& req, httplib::Response& res) {
+  if (req.path.rfind("/api/", 0) == 0 || req.path == "/api") {
+    send_problem(res, 404, "no such route: " + req.method + " " + req.path);
+    return;
+  }
+  auto file = static_file(web_root, req.path);
+  if (!file) {
+    if (req.path == "/" || req.path == "/index.html") {
+      res.set_content(missing_web_root_page(web_root), "text/html; charset=utf-8");
+      return;
+    }
+    send_problem(res, 404, "no such file: " + req.path.substr(0, 200));
+    return;
+  }
+  res.set_header("Cache-Control", "no-cache");
+  res.set_content(read_file(*file), mime_for(*file));
+}
+
+HttpServer::HttpServer(const Options& options, JobManager& jobs, Metrics& metrics, Logger& log,
+                       std::filesystem::path web_root)
+    : impl_(std::make_unique<Impl>(options, jobs, metrics, log, std::move(web_root))) {
+  impl_->setup();
+}
+
+HttpServer::~HttpServer() = default;
+
+int HttpServer::bind() {
+  const Options& o = impl_->options;
+  int port = o.port;
+  if (port == 0) port = impl_->server.bind_to_any_port(o.host);
+  else if (!impl_->server.bind_to_port(o.host, port)) port = -1;
+  if (port <= 0) throw std::runtime_error("cannot listen on " + o.host + ":" + std::to_string(o.port));
+  return port;
+}
+
+bool HttpServer::serve() { return impl_->server.listen_after_bind(); }
+
+void HttpServer::stop() {
+  impl_->jobs.wake_all();
+  impl_->server.stop();
+}
+
+std::size_t HttpServer::open_streams() const { return impl_->streams.load(); }
+
+}  // namespace remeshd

@@ -1,0 +1,420 @@
+#include "job_manager.h"
+
+#include <algorithm>
+#include <chrono>
+
+#include "job_runner.h"
+
+namespace remeshd {
+
+using remesh::IterationStats;
+using remesh::api::JobRecord;
+using remesh::api::JobState;
+using remesh::api::now_seconds;
+using remesh::api::state_name;
+
+namespace {
+
+std::chrono::duration<double> secs(double s) { return std::chrono::duration<double>(s); }
+
+}  // namespace
+
+JobManager::JobManager(ManagerConfig config, JobStore& store, Logger& log, Metrics& metrics)
+    : config_(config), store_(store), log_(log), metrics_(metrics) {
+  config_.workers = std::max(1u, config_.workers);
+}
+
+JobManager::~JobManager() { shutdown(); }
+
+void JobManager::persist(const JobRecord& record) {
+  try {
+    store_.save_state(record);
+  } catch (const std::exception& e) {
+    log_.error("storage", {str("job", record.id), str("error", e.what())});
+  }
+}
+
+void JobManager::transition(Job& job, JobState state) {
+  JobRecord& r = job.record;
+  JobState from = r.state;
+  r.state = state;
+  double now = now_seconds();
+  if (state == JobState::Running) r.started_at = now;
+  if (remesh::api::is_final(state)) {
+    r.finished_at = now;
+    metrics_.count_job_finished(std::string(state_name(state)));
+    janitor_wake_.notify_all();
+  }
+  job.events.push_back({JobEvent::Kind::State, state, 0});
+  persist(r);
+  std::vector<LogField> fields = {str("job", r.id), str("from", std::string(state_name(from))),
+                                  str("to", std::string(state_name(state)))};
+  if (r.outcome) fields.push_back(str("outcome", *r.outcome));
+  if (r.error) fields.push_back(str("error", *r.error));
+  if (r.started_at && remesh::api::is_final(state)) fields.push_back(num("run_seconds", now - *r.started_at));
+  log_.info("job", fields);
+  changed_.notify_all();
+}
+
+void JobManager::start() {
+  std::vector<std::string> problems;
+  std::vector<JobStore::Loaded> loaded = store_.load_all(problems);
+  for (const std::string& p : problems) log_.warn("storage", {str("skipped", p)});
+  std::sort(loaded.begin(), loaded.end(),
+            [](const auto& a, const auto& b) { return a.record.created_at < b.record.created_at; });
+  std::size_t requeued = 0;
+  {
+    std::lock_guard lock(mutex_);
+    for (JobStore::Loaded& l : loaded) {
+      auto job = std::make_shared<Job>();
+      job->record = std::move(l.record);
+      JobRecord& r = job->record;
+      if (r.state == JobState::Cancelling) {  // the user asked; the process ended first
+        r.state = JobState::Cancelled;
+        r.outcome = "cancelled";
+        r.finished_at = now_seconds();
+        persist(r);
+      }
+      if (remesh::api::is_final(r.state)) {
+        job->rows = std::move(l.rows);
+        job->events.push_back({JobEvent::Kind::State, JobState::Queued, 0});
+        if (r.started_at) job->events.push_back({JobEvent::Kind::State, JobState::Running, 0});
+        for (std::size_t i = 0; i < job->rows.size(); ++i)
+          job->events.push_back({JobEvent::Kind::Iteration, r.state, i});
+        job->events.push_back({JobEvent::Kind::State, r.state, 0});
+      } else {  // accepted but not finished: run it (again) from the start
+        r.state = JobState::Queued;
+        r.started_at.reset();
+        r.iteration = 0;
+        r.latest.reset();
+        try {
+          store_.clear_stats(r.id);
+        } catch (const std::exception& e) {
+          log_.warn("storage", {str("job", r.id), str("error", e.what())});
+        }
+        persist(r);
+        job->events.push_back({JobEvent::Kind::State, JobState::Queued, 0});
+        queue_.push_back(r.id);
+        ++requeued;
+      }
+      jobs_[r.id] = job;
+    }
+  }
+  log_.info("storage", {str("dir", store_.root().string()), num("jobs", static_cast<double>(loaded.size())),
+                        num("requeued", static_cast<double>(requeued))});
+  for (unsigned i = 0; i < config_.workers; ++i) workers_.emplace_back([this] { worker_loop(); });
+  janitor_ = std::thread([this] { janitor_loop(); });
+}
+
+void JobManager::shutdown() {
+  {
+    std::lock_guard lock(mutex_);
+    if (stopping_ && workers_.empty()) return;
+    stopping_ = true;
+    for (auto& [id, job] : jobs_)
+      if (job->record.state == JobState::Running || job->record.state == JobState::Cancelling) {
+        job->interrupted = true;
+        job->stop.request_stop();
+      }
+  }
+  work_.notify_all();
+  changed_.notify_all();
+  janitor_wake_.notify_all();
+  for (std::thread& t : workers_)
+    if (t.joinable()) t.join();
+  workers_.clear();
+  if (janitor_.joinable()) janitor_.join();
+}
+
+void JobManager::wake_all() { changed_.notify_all(); }
+
+JobManager::Submit JobManager::submit(const JobRecord& record, std::string_view upload) {
+  {
+    std::lock_guard lock(mutex_);
+    if (stopping_) return Submit::ShuttingDown;
+    if (queue_.size() >= config_.queue_size) return Submit::QueueFull;
+  }
+  store_.create(record, upload);  // outside the lock: it syncs to disk
+  std::lock_guard lock(mutex_);
+  auto job = std::make_shared<Job>();
+  job->record = record;
+  job->events.push_back({JobEvent::Kind::State, JobState::Queued, 0});
+  jobs_[record.id] = job;
+  queue_.push_back(record.id);
+  log_.info("job", {str("job", record.id), str("to", "queued"), str("format", record.format),
+                    num("bytes", static_cast<double>(record.bytes)),
+                    num("faces", record.summary.value("faces", 0.0))});
+  work_.notify_one();
+  changed_.notify_all();
+  return Submit::Accepted;
+}
+
+void JobManager::worker_loop() {
+  for (;;) {
+    std::string id;
+    {
+      std::unique_lock lock(mutex_);
+      work_.wait(lock, [&] { return stopping_ || !queue_.empty(); });
+      if (stopping_) return;
+      id = queue_.front();
+      queue_.pop_front();
+    }
+    run(id);
+  }
+}
+
+void JobManager::run(const std::string& id) {
+  std::shared_ptr<Job> job;
+  JobRecord record;
+  std::stop_token token;
+  {
+    std::lock_guard lock(mutex_);
+    auto it = jobs_.find(id);
+    if (it == jobs_.end() || it->second->record.state != JobState::Queued) return;
+    job = it->second;
+    job->record.iteration = 0;
+    job->record.latest.reset();
+    job->rows.clear();
+    transition(*job, JobState::Running);
+    ++busy_;
+    record = job->record;
+    token = job->stop.get_token();
+  }
+  auto finish = [&](JobState state) {
+    std::lock_guard lock(mutex_);
+    --busy_;
+    if (job->interrupted && job->record.state != JobState::Cancelling) {
+      log_.info("job", {str("job", id), str("interrupted", "shutdown"), str("state", "running (re-queued on start)")});
+      return;
+    }
+    transition(*job, state);
+  };
+  try {
+    std::string upload = store_.read_upload(id);
+    store_.clear_stats(id);
+    auto on_iteration = [&](const IterationStats& row) {
+      store_.append_stats(id, row);
+      metrics_.count_iteration();
+      std::lock_guard lock(mutex_);
+      job->rows.push_back(row);
+      job->events.push_back({JobEvent::Kind::Iteration, JobState::Running, job->rows.size() - 1});
+      job->record.latest = row;
+      job->record.iteration = row.iteration;
+      changed_.notify_all();
+    };
+    RunOutput out = run_job(record, upload, config_.engine_threads, on_iteration, token);
+    if (out.outcome == remesh::Outcome::Cancelled) {
+      {
+        std::lock_guard lock(mutex_);
+        job->record.outcome = "cancelled";
+      }
+      finish(JobState::Cancelled);
+      return;
+    }
+    for (const auto& [name, bytes] : out.files) store_.write_file(id, name, bytes);
+    {
+      std::lock_guard lock(mutex_);
+      job->record.outcome = std::string(remesh::api::outcome_name(out.outcome));
+      job->interrupted = false;  // it finished anyway
+    }
+    finish(JobState::Succeeded);
+  } catch (const std::exception& e) {
+    {
+      std::lock_guard lock(mutex_);
+      job->record.error = e.what();
+      job->interrupted = false;
+    }
+    finish(JobState::Failed);
+  } catch (...) {
+    {
+      std::lock_guard lock(mutex_);
+      job->record.error = "unknown error";
+      job->interrupted = false;
+    }
+    finish(JobState::Failed);
+  }
+}
+
+std::optional<JobRecord> JobManager::record(const std::string& id) const {
+  std::lock_guard lock(mutex_);
+  auto it = jobs_.find(id);
+  if (it == jobs_.end()) return std::nullopt;
+  return it->second->record;
+}
+
+std::optional<std::vector<IterationStats>> JobManager::rows(const std::string& id) const {
+  std::lock_guard lock(mutex_);
+  auto it = jobs_.find(id);
+  if (it == jobs_.end()) return std::nullopt;
+  return it->second->rows;
+}
+
+JobManager::Page JobManager::list(std::optional<JobState> state, std::size_t limit, std::size_t offset) const {
+  std::vector<const JobRecord*> matching;
+  Page page;
+  std::lock_guard lock(mutex_);
+  for (const auto& [id, job] : jobs_)
+    if (!state || job->record.state == *state) matching.push_back(&job->record);
+  std::sort(matching.begin(), matching.end(), [](const JobRecord* a, const JobRecord* b) {
+    return a->created_at != b->created_at ? a->created_at > b->created_at : a->id > b->id;
+  });
+  page.total = matching.size();
+  for (std::size_t i = offset; i < matching.size() && page.jobs.size() < limit; ++i)
+    page.jobs.push_back(*matching[i]);
+  return page;
+}
+
+JobManager::Cancel JobManager::cancel(const std::string& id, JobRecord* after) {
+  std::unique_lock lock(mutex_);
+  auto it = jobs_.find(id);
+  if (it == jobs_.end()) return Cancel::NotFound;
+  Job& job = *it->second;
+  switch (job.record.state) {
+    case JobState::Queued:
+      queue_.erase(std::remove(queue_.begin(), queue_.end(), id), queue_.end());
+      job.record.outcome = "cancelled";
+      transition(job, JobState::Cancelled);
+      break;
+    case JobState::Running:
+      transition(job, JobState::Cancelling);
+      job.stop.request_stop();
+      break;
+    case JobState::Cancelling:
+      break;
+    default: {  // finished: remove it and its files
+      jobs_.erase(it);
+      changed_.notify_all();
+      lock.unlock();
+      store_.remove(id);
+      log_.info("job", {str("job", id), str("removed", "by request")});
+      return Cancel::Removed;
+    }
+  }
+  if (after) *after = job.record;
+  return Cancel::Accepted;
+}
+
+std::optional<std::size_t> JobManager::start_cursor(const std::string& id, std::optional<int> last_event_id,
+                                                    std::optional<JobState>& state_before) const {
+  std::lock_guard lock(mutex_);
+  auto it = jobs_.find(id);
+  if (it == jobs_.end()) return std::nullopt;
+  state_before.reset();
+  if (!last_event_id) return 0;
+  const Job& job = *it->second;
+  for (std::size_t i = 0; i < job.events.size(); ++i) {
+    const JobEvent& e = job.events[i];
+    if (e.kind == JobEvent::Kind::State) state_before = e.state;
+    if (e.kind == JobEvent::Kind::Iteration && job.rows[e.row].iteration == *last_event_id) return i + 1;
+  }
+  state_before.reset();  // not found (e.g. the job ran again after a restart): everything
+  return 0;
+}
+
+JobManager::Batch JobManager::poll(const std::string& id, std::size_t cursor, double timeout_seconds) const {
+  Batch batch;
+  std::unique_lock lock(mutex_);
+  auto ready = [&] {
+    auto it = jobs_.find(id);
+    return stopping_ || it == jobs_.end() || it->second->events.size() > cursor ||
+           remesh::api::is_final(it->second->record.state);
+  };
+  changed_.wait_for(lock, secs(timeout_seconds), ready);
+  batch.shutting_down = stopping_;
+  auto it = jobs_.find(id);
+  if (it == jobs_.end()) return batch;
+  const Job& job = *it->second;
+  batch.found = true;
+  batch.state = job.record.state;
+  for (std::size_t i = cursor; i < job.events.size(); ++i) {
+    batch.events.push_back(job.events[i]);
+    batch.rows.push_back(job.events[i].kind == JobEvent::Kind::Iteration ? job.rows[job.events[i].row]
+                                                                         : IterationStats{});
+  }
+  batch.cursor = std::max(cursor, job.events.size());
+  batch.ended = remesh::api::is_final(job.record.state);
+  return batch;
+}
+
+std::filesystem::path JobManager::file(const std::string& id, const std::string& name) {
+  std::filesystem::path path = store_.file_path(id, name);
+  if (name.rfind("input.", 0) != 0 || std::filesystem::exists(path)) return path;
+  std::lock_guard file_lock(file_mutex_);
+  if (std::filesystem::exists(path)) return path;
+  auto rec = record(id);
+  if (!rec) throw std::runtime_error("job not found");
+  std::string bytes = convert_input(*rec, store_.read_upload(id), name.substr(6));
+  store_.write_file(id, name, bytes);
+  return path;
+}
+
+Gauges JobManager::gauges() const {
+  Gauges g;
+  for (JobState s : {JobState::Queued, JobState::Running, JobState::Succeeded, JobState::Failed,
+                     JobState::Cancelling, JobState::Cancelled})
+    g.jobs_by_state[std::string(state_name(s))] = 0;
+  std::lock_guard lock(mutex_);
+  for (const auto& [id, job] : jobs_) ++g.jobs_by_state[std::string(state_name(job->record.state))];
+  g.queue_depth = queue_.size();
+  g.busy_workers = busy_;
+  g.workers = config_.workers;
+  return g;
+}
+
+void JobManager::janitor_loop() {
+  double interval = config_.job_ttl_seconds > 0 ? std::clamp(config_.job_ttl_seconds / 4, 1.0, 60.0) : 60.0;
+  std::unique_lock lock(mutex_);
+  while (!stopping_) {
+    janitor_wake_.wait_for(lock, secs(interval));
+    if (stopping_) break;
+    lock.unlock();
+    try {
+      expire();
+    } catch (const std::exception& e) {
+      log_.error("janitor", {str("error", e.what())});
+    }
+    lock.lock();
+  }
+}
+
+void JobManager::expire() {
+  double now = now_seconds();
+  std::vector<std::pair<double, std::string>> finished;  // (finished_at, id)
+  std::vector<std::string> expired;
+  {
+    std::lock_guard lock(mutex_);
+    for (const auto& [id, job] : jobs_) {
+      const JobRecord& r = job->record;
+      if (!remesh::api::is_final(r.state) || !r.finished_at) continue;
+      if (config_.job_ttl_seconds > 0 && *r.finished_at + config_.job_ttl_seconds < now) expired.push_back(id);
+      else finished.emplace_back(*r.finished_at, id);
+    }
+    for (const std::string& id : expired) jobs_.erase(id);
+  }
+  for (const std::string& id : expired) {
+    store_.remove(id);
+    log_.info("job", {str("job", id), str("removed", "expired")});
+  }
+  if (config_.data_cap_bytes == 0) return;
+  std::vector<std::string> all;
+  {
+    std::lock_guard lock(mutex_);
+    for (const auto& [id, job] : jobs_) all.push_back(id);
+  }
+  std::uint64_t total = 0;
+  std::map<std::string, std::uint64_t> sizes;
+  for (const std::string& id : all) total += sizes[id] = store_.job_bytes(id);
+  std::sort(finished.begin(), finished.end());
+  for (const auto& [when, id] : finished) {
+    if (total <= config_.data_cap_bytes) break;
+    {
+      std::lock_guard lock(mutex_);
+      jobs_.erase(id);
+    }
+    store_.remove(id);
+    total -= std::min(total, sizes[id]);
+    log_.info("job", {str("job", id), str("removed", "data cap")});
+  }
+}
+
+}  // namespace remeshd

@@ -1,0 +1,75 @@
+// remeshd: the remeshing service. Parses options, opens the data directory, starts the workers and
+// the HTTP server, and shuts down cleanly on SIGTERM/SIGINT (running jobs stay re-queueable).
+#include <pthread.h>
+#include <signal.h>
+
+#include <cstdio>
+#include <thread>
+
+#include "http_server.h"
+#include "job_manager.h"
+#include "job_store.h"
+#include "log.h"
+#include "metrics.h"
+#include "options.h"
+#include "static_files.h"
+
+int main(int argc, char** argv) {
+  using namespace remeshd;
+  ParseResult parsed = parse_options(argc, argv);
+  if (!parsed.options) {
+    std::fprintf(parsed.exit_code ? stderr : stdout, "%s\n", parsed.message.c_str());
+    return parsed.exit_code;
+  }
+  const Options& o = *parsed.options;
+  Logger log(o.log_format == "json");
+
+  // Signals are taken by one thread (sigwait); every other thread blocks them.
+  sigset_t signals;
+  sigemptyset(&signals);
+  sigaddset(&signals, SIGINT);
+  sigaddset(&signals, SIGTERM);
+  pthread_sigmask(SIG_BLOCK, &signals, nullptr);
+  ::signal(SIGPIPE, SIG_IGN);
+
+  try {
+    unsigned cores = std::max(1u, std::thread::hardware_concurrency());
+    ManagerConfig mc;
+    mc.workers = o.workers ? o.workers : cores;
+    mc.queue_size = o.queue_size;
+    mc.job_ttl_seconds = o.job_ttl_hours * 3600.0;
+    mc.data_cap_bytes = static_cast<std::uint64_t>(o.data_cap_mb) * 1024 * 1024;
+    mc.engine_threads = std::max(1u, cores / mc.workers);
+
+    JobStore store(o.data_dir);
+    Metrics metrics;
+    JobManager jobs(mc, store, log, metrics);
+    std::filesystem::path web_root = resolve_web_root(o.web_root);
+    HttpServer http(o, jobs, metrics, log, web_root);
+    int port = http.bind();
+    jobs.start();
+    log.info("listening", {str("url", "http://" + o.host + ":" + std::to_string(port) + "/"), num("port", port),
+                           num("workers", mc.workers), str("data_dir", o.data_dir), str("web_root", web_root.string()),
+                           str("auth", o.token.empty() ? "off" : "bearer token"),
+                           str("cors", o.cors_origin.empty() ? "off" : o.cors_origin)});
+    if (o.host != "127.0.0.1" && o.host != "localhost" && o.host != "::1" && o.token.empty())
+      log.warn("security", {str("detail", "listening beyond loopback without --token")});
+
+    std::thread signal_thread([&] {
+      int sig = 0;
+      sigwait(&signals, &sig);
+      log.info("shutdown", {str("signal", sig == SIGTERM ? "SIGTERM" : sig == SIGINT ? "SIGINT" : "internal")});
+      jobs.shutdown();  // interrupts running jobs; they stay 'running' on disk and run again on start
+      http.stop();
+    });
+    bool ok = http.serve();
+    pthread_kill(signal_thread.native_handle(), SIGTERM);  // no-op if it already ran
+    signal_thread.join();
+    jobs.shutdown();
+    log.info("stopped", {});
+    return ok ? 0 : 1;
+  } catch (const std::exception& e) {
+    log.error("fatal", {str("error", e.what())});
+    return 1;
+  }
+}

@@ -1,0 +1,169 @@
+#include "options.h"
+
+#include <cctype>
+#include <charconv>
+#include <cmath>
+#include <cstdlib>
+#include <functional>
+#include <stdexcept>
+#include <vector>
+
+namespace remeshd {
+
+namespace {
+
+/// One option: its name (also the env name REMESHD_<NAME upper, '-' -> '_'>), help, setter.
+struct Spec {
+  const char* name;
+  const char* value_name;
+  const char* help;
+  std::function<void(Options&, const std::string&)> set;
+};
+
+std::size_t to_size(const std::string& name, const std::string& v) {
+  std::size_t out = 0;
+  auto [p, ec] = std::from_chars(v.data(), v.data() + v.size(), out);
+  if (ec != std::errc() || p != v.data() + v.size() || v.empty())
+    throw std::invalid_argument("--" + name + ": '" + v + "' is not a non-negative integer");
+  return out;
+}
+
+double to_double(const std::string& name, const std::string& v) {
+  double out = 0;
+  auto [p, ec] = std::from_chars(v.data(), v.data() + v.size(), out);
+  if (ec != std::errc() || p != v.data() + v.size() || v.empty() || !std::isfinite(out) || out < 0)
+    throw std::invalid_argument("--" + name + ": '" + v + "' is not a non-negative number");
+  return out;
+}
+
+const std::vector<Spec>& specs() {
+  static const std::vector<Spec> s = {
+      {"host", "ADDR", "listen address (default 127.0.0.1; 0.0.0.0 exposes the service)",
+       [](Options& o, const std::string& v) { o.host = v; }},
+      {"port", "N", "listen port (default 8080; 0 = any free port)",
+       [](Options& o, const std::string& v) {
+         std::size_t p = to_size("port", v);
+         if (p > 65535) throw std::invalid_argument("--port: " + v + " is not a port (0..65535)");
+         o.port = static_cast<int>(p);
+       }},
+      {"workers", "N", "remesh worker threads (default: number of cores)",
+       [](Options& o, const std::string& v) { o.workers = static_cast<unsigned>(to_size("workers", v)); }},
+      {"data-dir", "DIR",
+       "job storage (default $XDG_STATE_HOME/remeshd, else ~/.local/state/remeshd, else ./remeshd-data)",
+       [](Options& o, const std::string& v) { o.data_dir = v; }},
+      {"max-upload-mb", "N", "largest upload in MiB (default 256)",
+       [](Options& o, const std::string& v) { o.max_upload_mb = to_size("max-upload-mb", v); }},
+      {"max-faces", "N", "largest input mesh in faces (default 2000000)",
+       [](Options& o, const std::string& v) { o.max_faces = to_size("max-faces", v); }},
+      {"max-output-faces", "N", "largest estimated result in faces (default 5000000)",
+       [](Options& o, const std::string& v) { o.max_output_faces = to_size("max-output-faces", v); }},
+      {"max-iterations", "N", "largest iterations parameter (default 1000)",
+       [](Options& o, const std::string& v) {
+         std::size_t n = to_size("max-iterations", v);
+         if (n < 1 || n > 1'000'000) throw std::invalid_argument("--max-iterations: must be 1..1000000");
+         o.max_iterations = static_cast<int>(n);
+       }},
+      {"queue-size", "N", "queued jobs accepted before 503 (default 64)",
+       [](Options& o, const std::string& v) { o.queue_size = to_size("queue-size", v); }},
+      {"job-ttl-hours", "H", "finished jobs are deleted after H hours (default 168; 0 = never)",
+       [](Options& o, const std::string& v) { o.job_ttl_hours = to_double("job-ttl-hours", v); }},
+      {"data-cap-mb", "N", "size cap of the data directory in MiB, oldest finished jobs go first (default 10240; 0 = none)",
+       [](Options& o, const std::string& v) { o.data_cap_mb = to_size("data-cap-mb", v); }},
+      {"token", "T", "require 'Authorization: Bearer T' on every /api route (default: none)",
+       [](Options& o, const std::string& v) { o.token = v; }},
+      {"cors-origin", "O", "allow cross-origin requests from O ('*' = any; default: CORS off)",
+       [](Options& o, const std::string& v) { o.cors_origin = v; }},
+      {"log-format", "text|json", "log line format (default text)",
+       [](Options& o, const std::string& v) {
+         if (v != "text" && v != "json") throw std::invalid_argument("--log-format: '" + v + "' is not text or json");
+         o.log_format = v;
+       }},
+      {"web-root", "DIR", "directory of the web page (default: the build's web/ or <exe>/../web)",
+       [](Options& o, const std::string& v) { o.web_root = v; }},
+      {"http-threads", "N", "HTTP thread pool size (default: max-streams + 16)",
+       [](Options& o, const std::string& v) { o.http_threads = static_cast<unsigned>(to_size("http-threads", v)); }},
+      {"max-streams", "N", "concurrent event streams before 503 (default 64)",
+       [](Options& o, const std::string& v) { o.max_streams = static_cast<unsigned>(to_size("max-streams", v)); }},
+      {"stream-lifetime-seconds", "S", "an event stream ends after S seconds; clients reconnect (default 300)",
+       [](Options& o, const std::string& v) {
+         o.stream_lifetime_seconds = to_double("stream-lifetime-seconds", v);
+         if (o.stream_lifetime_seconds < 1) throw std::invalid_argument("--stream-lifetime-seconds: at least 1");
+       }},
+      {"heartbeat-seconds", "S", "': ping' comment interval on idle streams (default 15)",
+       [](Options& o, const std::string& v) {
+         o.heartbeat_seconds = to_double("heartbeat-seconds", v);
+         if (o.heartbeat_seconds < 0.1) throw std::invalid_argument("--heartbeat-seconds: at least 0.1");
+       }},
+  };
+  return s;
+}
+
+std::string env_name(const std::string& option) {
+  std::string e = "REMESHD_";
+  for (char c : option) e += c == '-' ? '_' : static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+  return e;
+}
+
+}  // namespace
+
+std::string default_data_dir() {
+  if (const char* x = std::getenv("XDG_STATE_HOME"); x && *x) return std::string(x) + "/remeshd";
+  if (const char* h = std::getenv("HOME"); h && *h) return std::string(h) + "/.local/state/remeshd";
+  return "./remeshd-data";
+}
+
+std::string help_text() {
+  std::string t =
+      "remeshd: the remeshing service (HTTP API under /api/v1, web page at /)\n\n"
+      "usage: remeshd [options]\n\n"
+      "Every option can also be set by an environment variable (shown); the command line wins.\n\n";
+  for (const Spec& s : specs()) {
+    std::string left = std::string("  --") + s.name + " " + s.value_name;
+    if (left.size() < 34) left.resize(34, ' ');
+    t += left + " " + s.help + "  [" + env_name(s.name) + "]\n";
+  }
+  t += "  --help                             this text\n";
+  return t;
+}
+
+ParseResult parse_options(int argc, char** argv) {
+  ParseResult result;
+  Options o;
+  try {
+    for (const Spec& s : specs())
+      if (const char* v = std::getenv(env_name(s.name).c_str())) s.set(o, v);
+    for (int i = 1; i < argc; ++i) {
+      std::string arg = argv[i];
+      if (arg == "--help" || arg == "-h") {
+        result.message = help_text();
+        return result;
+      }
+      if (arg.rfind("--", 0) != 0) throw std::invalid_argument("unexpected argument '" + arg + "' (see --help)");
+      std::string name = arg.substr(2), value;
+      bool has_value = false;
+      if (auto eq = name.find('='); eq != std::string::npos) {
+        value = name.substr(eq + 1);
+        name = name.substr(0, eq);
+        has_value = true;
+      }
+      const Spec* spec = nullptr;
+      for (const Spec& s : specs())
+        if (name == s.name) spec = &s;
+      if (!spec) throw std::invalid_argument("unknown option '--" + name + "' (see --help)");
+      if (!has_value) {
+        if (i + 1 >= argc) throw std::invalid_argument("--" + name + " needs a value");
+        value = argv[++i];
+      }
+      spec->set(o, value);
+    }
+  } catch (const std::invalid_argument& e) {
+    result.message = std::string("remeshd: ") + e.what();
+    result.exit_code = 2;
+    return result;
+  }
+  if (o.data_dir.empty()) o.data_dir = default_data_dir();
+  result.options = o;
+  return result;
+}
+
+}  // namespace remeshd

@@ -1,0 +1,126 @@
+// Uploads turned into jobs: format resolution, parameter and mesh errors, limits.
+#include <catch2/catch.hpp>
+
+#include <set>
+
+#include "api/upload.h"
+#include "io/mesh_io.h"
+#include "support/mesh_generators.h"
+
+using namespace remesh;
+using namespace remesh::api;
+using remesh::test::make_icosphere;
+
+namespace {
+
+std::string sphere_obj() { return write_mesh(make_icosphere(2), Format::Obj); }
+
+ParsedParams good_params() {
+  return params_from_json(nlohmann::json{{"emin", 0.2}, {"emax", 0.4}, {"iterations", 3}});
+}
+
+std::set<std::string> fields_of(const ParamsError& e) {
+  std::set<std::string> s;
+  for (const auto& f : e.errors()) s.insert(f.field);
+  return s;
+}
+
+}  // namespace
+
+TEST_CASE("formats come from the parameter, the file name, then the Content-Type", "[api][upload]") {
+  struct Row {
+    const char* param;
+    const char* filename;
+    const char* content_type;
+    std::optional<Format> expected;
+    bool error;
+  };
+  const Row rows[] = {
+      {"obj", "x.stl", "model/stl", Format::Obj, false},
+      {"", "bunny.PLY", "model/obj", Format::Ply, false},
+      {"", "mesh", "model/stl", Format::Stl, false},
+      {"", "", "model/gltf-binary", Format::Glb, false},
+      {"", "", "model/gltf+json; charset=utf-8", Format::Gltf, false},
+      {"", "", "application/octet-stream", std::nullopt, false},
+      {"", "", "", std::nullopt, false},
+      {"", "a.unknown", "model/obj", Format::Obj, false},
+      {"fbx", "a.obj", "", std::nullopt, true},
+      {"xyz", "", "", std::nullopt, true},
+  };
+  for (const Row& r : rows) {
+    INFO(r.param << " | " << r.filename << " | " << r.content_type);
+    std::vector<FieldError> errors;
+    CHECK(resolve_format(r.param, r.filename, r.content_type, errors) == r.expected);
+    CHECK(errors.empty() == !r.error);
+    if (r.error) CHECK(errors.front().field == "format");
+  }
+}
+
+TEST_CASE("safe_stem keeps download names harmless", "[api][upload]") {
+  CHECK(safe_stem("bunny.obj") == "bunny");
+  CHECK(safe_stem("../../etc/passwd") == "passwd");
+  CHECK(safe_stem("C:\\models\\cow.stl") == "cow");
+  CHECK(safe_stem("a \"quoted\"; name.ply") == "a__quoted___name");
+  CHECK(safe_stem("") == "mesh");
+  CHECK(safe_stem(".hidden") == "hidden");
+  CHECK(safe_stem(std::string(500, 'a') + ".obj").size() == 80);
+}
+
+TEST_CASE("prepare_job validates, reads and summarises", "[api][upload]") {
+  std::string obj = sphere_obj();
+  PreparedJob job = prepare_job(obj, "ball.obj", Format::Obj, good_params(), {});
+  CHECK(is_valid_job_id(job.record.id));
+  CHECK(job.record.state == JobState::Queued);
+  CHECK(job.record.format == "obj");
+  CHECK(job.record.bytes == obj.size());
+  CHECK(job.record.summary["faces"] == job.mesh.mesh.n_faces());
+  CHECK(job.record.summary["genus"] == nlohmann::json::array({0}));
+  CHECK(job.record.params.iterations == 3);
+  // Sniffed when no format is given.
+  CHECK(prepare_job(obj, "", std::nullopt, good_params(), {}).record.format == "obj");
+}
+
+TEST_CASE("prepare_job: the errors it must give", "[api][upload]") {
+  std::string obj = sphere_obj();
+  auto params = [](nlohmann::json j) { return params_from_json(j); };
+
+  SECTION("every bad parameter, before the mesh is read") {
+    try {
+      prepare_job("not a mesh", "x.obj", Format::Obj,
+                  params({{"emin", -1}, {"emax", 0.4}, {"rings", 9}, {"iterations", "x"}}), {});
+      FAIL("no ParamsError");
+    } catch (const ParamsError& e) {
+      CHECK(fields_of(e) == std::set<std::string>{"emin", "rings", "iterations"});
+    }
+    try {
+      prepare_job(obj, "x.obj", Format::Obj, params({{"emin", 0.5}, {"emax", 0.4}}), {});
+      FAIL("no ParamsError");
+    } catch (const ParamsError& e) {
+      CHECK_FALSE(e.errors().empty());
+    }
+  }
+  SECTION("iterations over the service limit") {
+    UploadLimits limits;
+    limits.max_iterations = 2;
+    try {
+      prepare_job(obj, "x.obj", Format::Obj, good_params(), limits);
+      FAIL("no ParamsError");
+    } catch (const ParamsError& e) {
+      CHECK(fields_of(e) == std::set<std::string>{"iterations"});
+    }
+  }
+  SECTION("unreadable meshes give the reader's message") {
+    CHECK_THROWS_AS(prepare_job("v 0 0 0\nf 1 2 3\n", "x.obj", Format::Obj, good_params(), {}), MeshError);
+    CHECK_THROWS_AS(prepare_job("", "x.obj", Format::Obj, good_params(), {}), MeshError);
+    CHECK_THROWS_AS(prepare_job("\x01\x02garbage", "x", std::nullopt, good_params(), {}), MeshError);
+  }
+  SECTION("faces and estimated output faces over the limits") {
+    UploadLimits limits;
+    limits.max_faces = 10;
+    CHECK_THROWS_AS(prepare_job(obj, "x.obj", Format::Obj, good_params(), limits), LimitError);
+    UploadLimits out;
+    out.max_output_faces = 100;
+    CHECK_THROWS_AS(prepare_job(obj, "x.obj", Format::Obj, params({{"emin", 0.001}, {"emax", 0.002}}), out),
+                    LimitError);
+  }
+}
