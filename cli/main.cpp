@@ -53,9 +53,13 @@ int dispatch(const std::string& command, const std::vector<std::string>& rest) {
 int run(int argc, char** argv) {
   using namespace remesh::cli;
   std::vector<std::string> args(argv + 1, argv + argc);
-  if (args.empty() || args[0] == "--help" || args[0] == "-h") {
+  if (args.empty()) {
+    std::cerr << kOverview;
+    return 2;
+  }
+  if (args[0] == "--help" || args[0] == "-h") {
     std::cout << kOverview;
-    return args.empty() ? 2 : 0;
+    return 0;
   }
   if (args[0] == "--version") {
     std::cout << "remesh " << REMESH_VERSION << "\n";

@@ -205,18 +205,15 @@ TEST_CASE("info reports repairs: a quad mesh is triangulated", "[cli]") {
   CHECK(text.out.find(j.at("repairs")[0].at("kind").get<std::string>()) != std::string::npos);
 }
 
-TEST_CASE("convert round trip obj -> ply -> obj keeps the counts", "[cli]") {
+TEST_CASE("convert round trips obj -> ply/off/stl/glb -> obj keep the counts", "[cli]") {
   TempDir dir;
   const TriMesh torus = remesh::test::make_torus(16, 8, 2.0, 0.5);
   write_obj(torus, dir.file("torus.obj"));
   for (const char* ext : {"ply", "off", "stl", "glb"}) {
     const std::string mid = dir.file(std::string("torus.") + ext);
     const std::string back = dir.file(std::string("back_") + ext + ".obj");
-    const std::vector<std::string> weld = std::string(ext) == "stl" ? std::vector<std::string>{"--weld"}
-                                                                    : std::vector<std::string>{};
-    std::vector<std::string> first = {"convert", dir.file("torus.obj"), mid};
-    std::vector<std::string> second = {"convert", mid, back};
-    second.insert(second.end(), weld.begin(), weld.end());
+    const std::vector<std::string> first = {"convert", dir.file("torus.obj"), mid};
+    const std::vector<std::string> second = {"convert", mid, back};
     INFO(ext);
     REQUIRE(remesh_cli(first).exit_code == 0);
     const ProcessResult r = remesh_cli(second);
