@@ -98,11 +98,15 @@ void weld(TriSoup& soup, std::vector<Repair>& repairs) {
 }
 
 /// Twice the area is below 1e-12 of the longest edge squared: zero within double rounding.
+/// Computed on points scaled by their largest coordinate so huge or tiny values cannot overflow.
 bool degenerate(const TriSoup& soup, const Tri& t) {
   if (t[0] == t[1] || t[1] == t[2] || t[0] == t[2]) return true;
   const Vec3 &a = soup.points[t[0]], &b = soup.points[t[1]], &c = soup.points[t[2]];
-  const double twice_area = OpenMesh::cross(b - a, c - a).norm();
-  const double longest = std::max({(b - a).sqrnorm(), (c - b).sqrnorm(), (a - c).sqrnorm()});
+  const double m = std::max({a.max_abs(), b.max_abs(), c.max_abs()});
+  if (!(m > 0)) return true;
+  const Vec3 sa = a / m, sb = b / m, sc = c / m;
+  const double twice_area = OpenMesh::cross(sb - sa, sc - sa).norm();
+  const double longest = std::max({(sb - sa).sqrnorm(), (sc - sb).sqrnorm(), (sa - sc).sqrnorm()});
   return !(twice_area > 1e-12 * longest);
 }
 

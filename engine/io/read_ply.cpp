@@ -249,14 +249,14 @@ RawSoup read_ply(std::string_view bytes, const ReadOptions& options) {
   const bool binary = h.encoding != Encoding::Ascii;
   check_face_limit(h.elements[static_cast<std::size_t>(layout.face_element)].count, options, "PLY");
   {
-    std::uint64_t need = 0, left = bytes.size() - h.data_start;
+    const std::uint64_t left = bytes.size() - h.data_start;
+    std::uint64_t need = 0;
     for (const Element& e : h.elements) {
-      std::uint64_t per = min_bytes(e, binary);
-      if (e.count > left / per) need = left + 1;
-      else need += e.count * per;
-      if (need > left + 1)
+      const std::uint64_t per = min_bytes(e, binary);
+      if (e.count > (left + 2) / per || need + e.count * per > left + 2)
         fail("PLY header claims " + std::to_string(e.count) + " '" + e.name + "' elements, but only " +
              std::to_string(left) + " bytes follow (file truncated?)");
+      need += e.count * per;
     }
   }
   RawSoup soup;

@@ -1,0 +1,189 @@
+// Reading each input format, with the format-specific details the readers must handle.
+#include <catch2/catch.hpp>
+
+#include "io/mesh_io.h"
+#include "io/summary.h"
+#include "io_test_util.h"
+#include "support/mesh_generators.h"
+
+using namespace remesh;
+
+namespace {
+
+LoadedMesh read_as(const std::string& bytes, std::optional<Format> f = std::nullopt) {
+  ReadOptions o;
+  o.format = f;
+  return read_mesh(bytes, o);
+}
+
+const std::string kCubeObj =
+    "# a unit cube with quads\r\n"
+    "mtllib cube.mtl\r\n"
+    "o cube\r\n"
+    "v 0 0 0\r\nv 1 0 0\r\nv 1 1 0\r\nv 0 1 0\r\n"
+    "v 0 0 1\r\nv 1 0 1\r\nv 1 1 1\r\nv 0 1 1\r\n"
+    "vt 0 0\r\nvt 1 0\r\nvt 1 1\r\nvn 0 0 1\r\n"
+    "g bottom\r\ns off\r\nusemtl red\r\n"
+    "f 1/1 4/2 3/3 2/1\r\n"
+    "g top\r\ns 1\r\n"
+    "f 5//1 6//1 7//1 8//1\r\n"
+    "f 1/1/1 2/2/1 6/3/1 5/1/1\r\n"
+    "f -7 -6 -2 -3\r\n"  // 2 3 7 6 through negative indices
+    "f 3 4 8 7\r\n"
+    "f 4 1 5 8\r\n";
+
+}  // namespace
+
+TEST_CASE("OBJ: index forms, negative indices, groups, CRLF and quads") {
+  LoadedMesh m = read_as(kCubeObj);
+  CHECK(m.format == Format::Obj);
+  CHECK(m.mesh.n_vertices() == 8);
+  CHECK(m.mesh.n_faces() == 12);
+  REQUIRE(!m.repairs.empty());
+  CHECK(m.repairs[0].kind == "polygons_triangulated");
+  CHECK(m.repairs[0].count == 6);
+  MeshSummary s = summarize(m.mesh);
+  CHECK(s.euler == 2);
+  CHECK(s.boundary_loops == 0);
+  CHECK(s.area == Approx(6.0));
+  CHECK(test::check_loaded(m.mesh).empty());
+}
+
+TEST_CASE("OBJ: a concave polygon is ear-clipped, not fanned across the outside") {
+  // An L-shaped hexagon: a fan from vertex 0 would create a triangle outside the polygon.
+  const std::string obj =
+      "v 1 1 0\nv 2 1 0\nv 2 2 0\nv 0 2 0\nv 0 0 0\nv 1 0 0\n"
+      "f 1 2 3 4 5 6\n";
+  LoadedMesh m = read_as(obj);
+  CHECK(m.mesh.n_faces() == 4);
+  CHECK(summarize(m.mesh).area == Approx(3.0));
+  for (auto f : m.mesh.faces()) CHECK(m.mesh.normal(f)[2] > 0.99);
+}
+
+TEST_CASE("OFF: ASCII with comments, colours and counts on the header line; binary OFF") {
+  const std::string off =
+      "COFF 4 4 6 # tetrahedron\n"
+      "# vertices\n"
+      "0 0 0 255 0 0 255\n1 0 0 0 255 0 255\n0 1 0 0 0 255 255\n\n0 0 1 9 9 9 255\n"
+      "3 0 2 1 1 0 0\n3 0 1 3\n3 1 2 3\n3 0 3 2\n";
+  LoadedMesh m = read_as(off);
+  CHECK(m.format == Format::Off);
+  CHECK(m.mesh.n_faces() == 4);
+  CHECK(summarize(m.mesh).euler == 2);
+
+  PolygonSoup soup = to_soup(test::make_icosphere(1));
+  LoadedMesh b = read_as(test::write_off_binary(soup));
+  CHECK(b.format == Format::Off);
+  CHECK(b.mesh.n_faces() == 80);
+  CHECK(b.repairs.empty());
+}
+
+TEST_CASE("PLY: ascii, both binary byte orders, extra properties and elements") {
+  PolygonSoup soup = to_soup(test::make_icosphere(1));
+  for (const std::string& bytes : {test::write_ply_ascii(soup), test::write_ply_big_endian(soup),
+                                   write_mesh(soup, Format::Ply)}) {
+    LoadedMesh m = read_as(bytes);
+    CHECK(m.format == Format::Ply);
+    CHECK(m.mesh.n_vertices() == soup.points.size());
+    CHECK(m.mesh.n_faces() == 80);
+    CHECK(m.repairs.empty());
+    CHECK(m.mesh.point(TriMesh::VertexHandle(5))[0] == Approx(soup.points[5][0]).epsilon(1e-6));
+  }
+}
+
+TEST_CASE("STL: ASCII, binary, and binary whose header starts with 'solid'") {
+  PolygonSoup soup = to_soup(test::make_icosphere(1));
+  LoadedMesh a = read_as(test::write_stl_ascii(soup));
+  CHECK(a.format == Format::Stl);
+  CHECK(a.mesh.n_vertices() == 42);  // welded by position, not reported as a repair
+  CHECK(a.repairs.empty());
+
+  std::string bin = write_mesh(soup, Format::Stl);
+  bin.replace(0, 12, "solid trick ");
+  CHECK(detect_format(bin) == Format::Stl);
+  LoadedMesh b = read_as(bin);
+  CHECK(b.mesh.n_vertices() == 42);
+  CHECK(b.mesh.n_faces() == 80);
+  CHECK(b.repairs.empty());
+}
+
+TEST_CASE("glTF: data URI buffer and GLB") {
+  PolygonSoup soup = to_soup(test::make_icosphere(1));
+  LoadedMesh g = read_as(test::write_gltf_data_uri(soup));
+  CHECK(g.format == Format::Gltf);
+  CHECK(g.mesh.n_faces() == 80);
+  LoadedMesh b = read_as(write_mesh(soup, Format::Glb));
+  CHECK(b.format == Format::Glb);
+  CHECK(b.mesh.n_faces() == 80);
+}
+
+TEST_CASE("glTF: node transforms (TRS and matrix, nested), strips, fans and several meshes are merged") {
+  // One triangle-strip quad in mesh 0 (used twice: translated and mirrored by a matrix) and a fan in mesh 1.
+  std::string bin;
+  auto put_f = [&](float v) { bin.append(reinterpret_cast<const char*>(&v), 4); };
+  for (float v : {0.f, 0.f, 0.f, 1.f, 0.f, 0.f, 0.f, 1.f, 0.f, 1.f, 1.f, 0.f}) put_f(v);
+  std::string b64;  // tiny base64 encoder, 48 bytes -> 64 chars
+  {
+    static const char* t = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    for (std::size_t i = 0; i < bin.size(); i += 3) {
+      unsigned v = (unsigned char)bin[i] << 16 | (unsigned char)bin[i + 1] << 8 | (unsigned char)bin[i + 2];
+      b64 += {t[v >> 18], t[(v >> 12) & 63], t[(v >> 6) & 63], t[v & 63]};
+    }
+  }
+  const std::string gltf = R"({"asset":{"version":"2.0"},"scene":0,"scenes":[{"nodes":[0,2]}],
+    "nodes":[{"translation":[0,0,5],"children":[1],"mesh":0},
+             {"matrix":[-1,0,0,0, 0,1,0,0, 0,0,1,0, 10,0,0,1],"mesh":0},
+             {"scale":[2,2,2],"rotation":[0,0,0.7071068,0.7071068],"mesh":1}],
+    "meshes":[{"primitives":[{"attributes":{"POSITION":0},"mode":5}]},
+              {"primitives":[{"attributes":{"POSITION":0},"mode":6},{"attributes":{"POSITION":0},"mode":1}]}],
+    "accessors":[{"bufferView":0,"componentType":5126,"count":4,"type":"VEC3"}],
+    "bufferViews":[{"buffer":0,"byteLength":48}],
+    "buffers":[{"byteLength":48,"uri":"data:application/octet-stream;base64,)" + b64 + R"("}]})";
+  LoadedMesh m = read_as(gltf);
+  CHECK(m.mesh.n_faces() == 6);  // 2 + 2 (strip, twice) + 2 (fan); the LINES primitive adds none
+  MeshSummary s = summarize(m.mesh);
+  CHECK(s.components == 3);
+  CHECK(s.area == Approx(1 + 1 + 4 * 0.5 + 4 * 0.5));  // fan 0,1,2 / 0,2,3 of the unit square scaled by 2
+  // The mirrored copy sits at x in [9, 10], z = 5, and still faces +z (winding flipped with the mirror).
+  bool found_mirror = false;
+  for (auto f : m.mesh.faces()) {
+    Vec3 c = m.mesh.calc_face_centroid(f);
+    if (c[0] > 9 && c[0] < 10) {
+      found_mirror = true;
+      CHECK(c[2] == Approx(5));
+    }
+  }
+  CHECK(found_mirror);
+  CHECK(s.bbox_min[0] == Approx(-2));  // the rotated fan reaches x = -2
+  CHECK(s.bbox_max[2] == Approx(5));
+}
+
+TEST_CASE("glTF: a buffer pointing to an external file is refused without reading it") {
+  PolygonSoup soup = to_soup(test::make_icosphere(0));
+  for (const std::string uri : {"../../../etc/passwd", "mesh.bin", "/etc/hostname"}) {
+    try {
+      read_as(test::write_gltf_data_uri(soup, uri));
+      FAIL("external URI accepted: " << uri);
+    } catch (const MeshError& e) {
+      CHECK_THAT(e.what(), Catch::Contains("external file") && Catch::Contains(uri));
+    }
+  }
+}
+
+TEST_CASE("Format detection and names") {
+  CHECK(parse_format("a/b/mesh.OBJ") == Format::Obj);
+  CHECK(parse_format(".glb") == Format::Glb);
+  CHECK(parse_format("ply") == Format::Ply);
+  CHECK_FALSE(parse_format("mesh.docx").has_value());
+  CHECK(detect_format("ply\nformat ascii 1.0\n") == Format::Ply);
+  CHECK(detect_format("OFF\n3 1 0\n") == Format::Off);
+  CHECK(detect_format("  {\"asset\":{}}") == Format::Gltf);
+  CHECK(detect_format("# comment\nv 1 2 3\n") == Format::Obj);
+  CHECK(detect_format("solid x\nfacet normal") == Format::Stl);
+  CHECK_FALSE(detect_format("hello world").has_value());
+  for (Format f : {Format::Obj, Format::Off, Format::Ply, Format::Stl, Format::Gltf, Format::Glb, Format::Xyz}) {
+    CHECK(parse_format(format_name(f)) == f);
+    CHECK(!mime_type(f).empty());
+  }
+  CHECK(mime_type(Format::Glb) == "model/gltf-binary");
+}
