@@ -113,7 +113,7 @@ export class Viewer {
     const group = new THREE.Group();
     group.add(surface, edges);
     const slot = { name, label, geometry, edge_geometry, surface, edges, group, pairs, lengths, classed,
-      stats: length_stats(lengths), vertices: vertex_count, faces: mesh.triangles.length / 3 };
+      stats: length_stats(lengths), vertices: used_vertices(pairs, vertex_count), faces: mesh.triangles.length / 3 };
     this.slots.set(name, slot);
     this.reclassify(slot);
     return slot.stats;
@@ -210,7 +210,9 @@ export class Viewer {
     if (!s) return;
     const { emin, emax } = s.classed ? this.interval : { emin: NaN, emax: NaN };
     const st = s.stats;
-    let hi = Math.min(st.max, Math.max(st.mean + 4 * st.deviation, Number.isFinite(emax) ? emax * 1.5 : 0));
+    // Up to mean + 4 deviations (a few huge edges must not squash the rest), but always past e_max.
+    let hi = Math.min(st.max, st.mean + 4 * st.deviation);
+    if (Number.isFinite(emax) && emax > 0) hi = Math.max(hi, Math.min(emax * 1.1, Math.max(st.max, emax * 1.1)));
     if (!(hi > 0)) hi = st.max || 1;
     const lo = 0;
     draw_histogram(this.hist, histogram(s.lengths, lo, hi, BINS), lo, hi, emin, emax,
@@ -219,4 +221,12 @@ export class Viewer {
       ` mean ${fmt(st.mean)}, deviation ${fmt(st.deviation)}, min ${fmt(st.min)}, max ${fmt(st.max)}` +
       (hi < st.max ? ` (axis clipped at ${fmt(hi)})` : '');
   }
+}
+
+/// Vertices that some edge uses (a GLB may carry positions for the fan triangulation only).
+function used_vertices(pairs, vertex_count) {
+  const seen = new Uint8Array(vertex_count);
+  let n = 0;
+  for (let i = 0; i < pairs.length; ++i) if (!seen[pairs[i]]) { seen[pairs[i]] = 1; ++n; }
+  return n;
 }
