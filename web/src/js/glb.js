@@ -42,21 +42,28 @@ export function parse_gltf(doc, buffers = []) {
   const tris = [];
   const lines = [];
   let base = 0;
+  const bases = new Map();
   const visit = (node_index, parent) => {
     const node = doc.nodes[node_index];
     const m = multiply(parent, node_matrix(node));
     if (node.mesh !== undefined) {
       for (const prim of doc.meshes[node.mesh].primitives || []) {
         if (prim.attributes?.POSITION === undefined) continue;
-        const pos = read(prim.attributes.POSITION);
-        const count = pos.length / 3;
-        pos_chunks.push(transform(pos, m));
+        // Primitives sharing a POSITION accessor (the dual's fan and its LINES) share vertices.
+        const key = `${prim.attributes.POSITION}|${m.join(',')}`;
+        let start = bases.get(key);
+        const count = doc.accessors[prim.attributes.POSITION].count;
+        if (start === undefined) {
+          start = base;
+          bases.set(key, start);
+          pos_chunks.push(transform(read(prim.attributes.POSITION), m));
+          base += count;
+        }
         const idx = prim.indices !== undefined ? read(prim.indices) : iota(count);
         const mode = prim.mode ?? 4;
-        if (mode === 1) lines.push(offset_by(idx, base));
-        else if (mode === 4) tris.push(offset_by(idx, base));
-        else if (mode === 5 || mode === 6) tris.push(offset_by(unstrip(idx, mode), base));
-        base += count;
+        if (mode === 1) lines.push(offset_by(idx, start));
+        else if (mode === 4) tris.push(offset_by(idx, start));
+        else if (mode === 5 || mode === 6) tris.push(offset_by(unstrip(idx, mode), start));
       }
     }
     for (const child of node.children || []) visit(child, m);

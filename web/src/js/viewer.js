@@ -212,7 +212,7 @@ export class Viewer {
     const st = s.stats;
     // Up to mean + 4 deviations (a few huge edges must not squash the rest), but always past e_max.
     let hi = Math.min(st.max, st.mean + 4 * st.deviation);
-    if (Number.isFinite(emax) && emax > 0) hi = Math.max(hi, Math.min(emax * 1.1, Math.max(st.max, emax * 1.1)));
+    if (Number.isFinite(emax) && emax > 0) hi = Math.max(hi, emax * 1.1);
     if (!(hi > 0)) hi = st.max || 1;
     const lo = 0;
     draw_histogram(this.hist, histogram(s.lengths, lo, hi, BINS), lo, hi, emin, emax,
