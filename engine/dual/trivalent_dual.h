@@ -12,7 +12,15 @@ namespace remesh {
 
 class ReferenceSurface;
 
-/// Precondition: a valid, consistently oriented TriMesh without deleted elements.
+/// On an open mesh a triangle whose three corners are all boundary vertices gives a dual vertex in
+/// no face; it is kept, so V* = F always holds (the XYZ atom list has one atom per triangle).
+/// The dual edges are the primal edges with at least one interior end vertex.
+///
+/// \pre `primal` is a valid, consistently oriented 2-manifold TriMesh (as read_mesh returns). A
+///      mesh with deleted elements is compacted first (on a copy); indices then refer to the copy.
+/// \param reference when not null, each centroid goes to reference->closest_point(centroid,
+///      triangle normal) (needs the remesher's library, remesh_equalize, linked).
+/// \throw MeshError if a dual face cannot be added (the primal was not a valid oriented manifold).
 PolyMesh trivalent_dual(const TriMesh& primal, const ReferenceSurface* reference = nullptr);
 
 }  // namespace remesh
