@@ -135,6 +135,8 @@ RawSoup read_off(std::string_view bytes, const ReadOptions& options) {
     soup.offsets.push_back(static_cast<std::uint32_t>(soup.indices.size()));
     soup.face_lines.push_back(static_cast<std::uint32_t>(ln));
   }
+  if (lines.remaining() == 0 && ends_mid_line(bytes))
+    fail_at(lines.line_number(), "the file ends inside the last line, without a line break (truncated?)");
   return soup;
 }
 

@@ -85,7 +85,7 @@ RawSoup read_ascii_stl(std::string_view bytes, const ReadOptions& options) {
   Welder welder(soup);
   LineScanner lines(bytes);
   std::string_view line, tok;
-  bool in_loop = false;
+  bool in_loop = false, ended = false;
   std::size_t corners = 0;
   while (lines.next(line)) {
     std::string_view rest = line;
@@ -110,11 +110,14 @@ RawSoup read_ascii_stl(std::string_view bytes, const ReadOptions& options) {
       if (!in_loop) fail_at(ln, "'endloop' without 'outer loop'");
       in_loop = false;
       soup.offsets.push_back(static_cast<std::uint32_t>(soup.indices.size()));
-    } else if (tok != "solid" && tok != "facet" && tok != "endfacet" && tok != "endsolid") {
+    } else if (tok == "endsolid") {
+      ended = true;
+    } else if (tok != "solid" && tok != "facet" && tok != "endfacet") {
       fail_at(ln, "unexpected keyword " + quote(tok));
     }
   }
   if (in_loop) fail("ASCII STL: file ends inside a facet (truncated?)");
+  if (!ended) fail("ASCII STL: no 'endsolid' line (truncated?)");
   (void)corners;
   return soup;
 }

@@ -231,3 +231,20 @@ TEST_CASE("Malformed text names the line") {
   CHECK_THROWS_WITH(read("ply\nformat ascii 1.0\nelement vertex 1\nproperty flot x\nend_header\n"),
                     Contains("PLY header line 4") && Contains("flot"));
 }
+
+TEST_CASE("Text files cut inside their last line are refused as truncated") {
+  // Cutting "f 1 2 3" or "3 0 1 2" inside a number leaves a well-formed but wrong face: refuse.
+  CHECK_THROWS_WITH(read(kTetraVerts + "f 1 3 2\nf 1 2 4\nf 2 3 4\nf 1 4"), Contains("OBJ line 8") && Contains("truncated"));
+  CHECK_THROWS_WITH(read(kTetraVerts + "f 1 3 2\nf 1 2 4\nf 2 3 4\nf 1 4 3"), Contains("truncated"));
+  CHECK_NOTHROW(read(kTetraVerts + kTetraFaces + "# trailing comment without a line break"));
+  CHECK_THROWS_WITH(read("OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2"), Contains("OFF line 6") && Contains("truncated"));
+  CHECK_NOTHROW(read("OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n"));
+  const std::string ply = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+                          "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n"
+                          "0 0 0\n1 0 0\n0 1 0\n3 0 1 2";
+  CHECK_THROWS_WITH(read(ply), Contains("PLY line 13") && Contains("truncated"));
+  CHECK_NOTHROW(read(ply + "\n"));
+  CHECK_THROWS_WITH(read("solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\n"
+                         "endloop\nendfacet\n"),
+                    Contains("endsolid"));
+}
