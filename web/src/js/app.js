@@ -5,10 +5,10 @@ import * as api from './api.js';
 import * as params from './params.js';
 import { read_preview, format_of } from './preview.js';
 import { parse_glb } from './glb.js';
+import { triangle_edges, edge_lengths, length_stats } from './edges.js';
 import { JobView } from './job_view.js';
 import { JobsList } from './jobs_list.js';
 import { fmt } from './charts.js';
-import { triangle_edges, edge_lengths, length_stats } from './edges.js';
 
 const $ = (id) => document.getElementById(id);
 const state = { file: null, input_of: null, viewer: null, loading: new Map() };
@@ -95,11 +95,11 @@ async function choose_file(file) {
   if (file.size > 200 * 1024 * 1024) { status('Large file: the preview appears after the upload.'); return; }
   status(`reading ${file.name}…`);
   try {
-    const mesh = await read_preview(file);
+    const mesh = await in_worker({ file });
     await state.viewer_ready;
     if (state.file !== file) return;
     const stats = state.viewer ? state.viewer.set_mesh('input', mesh, { label: 'input (local preview)' })
-      : length_stats(edge_lengths(mesh.positions, triangle_edges(mesh.triangles, mesh.positions.length / 3)));
+      : length_stats(mesh.lengths);
     state.viewer?.show('input');
     show_summary({ vertices: mesh.positions.length / 3, faces: mesh.faces,
       edge_length: stats ? { mean: stats.mean } : undefined }, 'local preview; the server summary follows the upload');
@@ -108,6 +108,32 @@ async function choose_file(file) {
   } catch (e) {
     status(`No local preview (${e.message}); the server reads it on upload.`);
   }
+}
+
+/// Reads {file} or parses {glb} and extracts the edges in mesh_worker.js; on the page's thread
+/// when workers are unavailable.
+function in_worker(message) {
+  return new Promise((resolve, reject) => {
+    let worker;
+    try {
+      worker = new Worker(new URL('./mesh_worker.js', import.meta.url), { type: 'module' });
+    } catch {
+      return resolve(on_this_thread(message));
+    }
+    worker.onmessage = ({ data }) => {
+      worker.terminate();
+      if (data.error) reject(new Error(data.error)); else resolve(data.mesh);
+    };
+    worker.onerror = (e) => { worker.terminate(); reject(new Error(e.message || 'mesh worker failed')); };
+    worker.postMessage(message);
+  });
+}
+
+async function on_this_thread(message) {
+  const mesh = message.file ? await read_preview(message.file) : parse_glb(message.glb);
+  const pairs = mesh.lines && mesh.lines.length ? mesh.lines
+    : triangle_edges(mesh.triangles, mesh.positions.length / 3);
+  return { ...mesh, pairs, lengths: edge_lengths(mesh.positions, pairs) };
 }
 
 function show_summary(s, source) {
@@ -261,7 +287,7 @@ async function load_mesh(name, id, show) {
     status(`loading ${name}…`);
     try {
       const res = await api.request(api.result_url(id, name === 'input' ? 'input' : name, 'glb'));
-      const mesh = parse_glb(await res.arrayBuffer());
+      const mesh = await in_worker({ glb: await res.arrayBuffer() });
       if (view.job?.id !== id) return;
       viewer.set_mesh(name, mesh, { classed: name !== 'dual',
         label: name === 'dual' ? 'dual (polygon edges)' : name });

@@ -91,7 +91,8 @@ export class Viewer {
     this.slots.delete(name);
   }
 
-  /// Prepares a mesh {positions, triangles, lines?} under a name ('input', 'remeshed', 'dual').
+  /// Prepares a mesh {positions, triangles, lines?, pairs?, lengths?} under a name ('input',
+  /// 'remeshed', 'dual'); `pairs`/`lengths` are the edges when already computed (mesh_worker.js).
   /// `classed`: colour its edges against [e_min, e_max] (not for the dual, whose edges are shorter
   /// by design). Polygon edges come from `lines` when given, else from the triangles.
   set_mesh(name, mesh, { classed = true, label = name } = {}) {
@@ -102,8 +103,8 @@ export class Viewer {
     geometry.setAttribute('position', position);
     geometry.setIndex(new THREE.BufferAttribute(mesh.triangles, 1));
     geometry.computeBoundingSphere();
-    const pairs = mesh.lines && mesh.lines.length ? mesh.lines : triangle_edges(mesh.triangles, vertex_count);
-    const lengths = edge_lengths(mesh.positions, pairs);
+    const pairs = mesh.pairs || (mesh.lines && mesh.lines.length ? mesh.lines : triangle_edges(mesh.triangles, vertex_count));
+    const lengths = mesh.lengths || edge_lengths(mesh.positions, pairs);
     const edge_geometry = new THREE.BufferGeometry();
     edge_geometry.setAttribute('position', position);
     edge_geometry.setIndex(new THREE.BufferAttribute(new Uint32Array(pairs.length), 1));
