@@ -243,6 +243,7 @@ const view = new JobView({
 const jobs = new JobsList();
 
 function reset_job_panel() {
+  document.title = 'remeshd';
   $('job-id').textContent = '–';
   $('job-state').textContent = 'idle';
   $('job-state').className = 'state';

@@ -181,6 +181,7 @@ export class JobView {
     const secs = this.rows.reduce((s, r) => s + (r.seconds || 0), 0);
     if (secs) text += ` · ${secs.toFixed(1)} s`;
     $('progress-text').textContent = text;
+    document.title = `${FINAL.has(job.state) ? job.state : `${done}/${total}`} · ${job.input?.filename || 'job'} · remeshd`;
     $('cancel').disabled = !(job.state === 'queued' || job.state === 'running');
     if (job.error) this.show_error(typeof job.error === 'string' ? job.error : job.error.detail || JSON.stringify(job.error));
   }

@@ -62,7 +62,23 @@ export class JobsList {
       meta.textContent = [job.id.slice(0, 8), when(job.created_at),
         p.iterations ? `${p.iteration ?? 0}/${p.iterations} it` : '', v ? `${v.toLocaleString()} v` : '']
         .filter(Boolean).join(' · ');
-      li.append(state, a, events, meta);
+      const links = document.createElement('span');
+      links.append(events);
+      if (['succeeded', 'failed', 'cancelled'].includes(job.state)) {
+        const del = document.createElement('button');
+        del.type = 'button';
+        del.className = 'link';
+        del.textContent = 'delete';
+        del.setAttribute('aria-label', `Delete job ${job.input?.filename || job.id} and its files`);
+        del.addEventListener('click', async () => {
+          if (!confirm(`Delete job ${job.id} (${job.input?.filename || ''}) and its files?`)) return;
+          try { await api.delete_job(job.id); } catch (e) { alert(e.message); }
+          if (job.id === this.current && location.hash) location.hash = '';
+          this.refresh();
+        });
+        links.append(' ', del);
+      }
+      li.append(state, a, links, meta);
       ol.append(li);
     }
     if (total > jobs.length)
