@@ -10,7 +10,8 @@
 
 namespace remesh::bench {
 
-/// Reads OFF/OBJ/PLY/STL with OpenMesh. Throws std::runtime_error naming the file on failure.
+/// Reads a mesh with the product's reader (remesh_io: validated, repaired) when it is built, else
+/// OFF/OBJ/PLY/STL with OpenMesh. Throws naming the file on failure.
 TriMesh load_mesh(const std::string& path);
 
 /// Writes an OFF file with 17 significant digits. Throws std::runtime_error on failure.

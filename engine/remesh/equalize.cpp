@@ -32,7 +32,10 @@ double seconds_since(Clock::time_point start) {
 constexpr int kFlipSweeps = 3;
 
 /// Fraction of edges inside [e_min, e_max] from which the interval cleanup runs every iteration.
-constexpr double kCleanupFrom = 0.99;
+/// Measured on spot.obj (Table 4.2 setup): from 0.97 the run converges (100 % inside) after 18
+/// iterations with 85 % regular vertices; from 0.99 after 52 with 86.7 %; cleanup in every iteration
+/// costs regularity (81 %), since its fixes fight the valence flips.
+constexpr double kCleanupFrom = 0.97;
 
 double inside_fraction(const TriMesh& mesh, const Params& params, unsigned threads) {
   return measure(mesh, params.e_min, params.e_max, threads).inside_fraction;
@@ -106,17 +109,21 @@ Result equalize(TriMesh& mesh, const Params& params, const OnIteration& on_itera
     counters.max_projection_distance = project_onto_reference(mesh, *reference, threads);
     undo_folds(mesh, before, threads);
 
-    // Not in the thesis: the post-process its conclusion asks for. It runs in the last iteration,
-    // and in every iteration once at least kCleanupFrom of the edges are inside, so that a run can
-    // reach every edge inside and stop early (convergence) instead of wandering around 99.6 %.
-    const bool last = i == params.iterations;
-    if (params.cleanup && !stop.stop_requested() &&
-        (last || (!params.run_all_iterations && inside_fraction(mesh, params, threads) >= kCleanupFrom))) {
-      const CleanupCounts c = interval_cleanup(mesh, *reference, params.e_min, params.e_max, params.flip_factor);
-      counters.cleanup_fixes = c.flips + c.collapses + c.splits + c.relocations;
-      counters.splits += c.splits;
-      counters.collapses += c.collapses;
-      counters.flips += c.flips;
+    // Not in the thesis: the post-process its conclusion asks for (interval_cleanup.h). It runs in
+    // the last iteration, and in every iteration once at least kCleanupFrom of the edges are inside,
+    // so that a run reaches every edge inside and stops early (convergence) instead of wandering
+    // around 99.6 %. On open meshes its boundary part runs every iteration (see interval_cleanup.h).
+    if (params.cleanup && !stop.stop_requested()) {
+      const bool last = i == params.iterations;
+      const bool full = last || (!params.run_all_iterations && inside_fraction(mesh, params, threads) >= kCleanupFrom);
+      if (full || reference->has_boundary()) {
+        const CleanupCounts c = interval_cleanup(mesh, *reference, params.e_min, params.e_max, params.flip_factor,
+                                                 4, !full);
+        counters.cleanup_fixes = c.flips + c.collapses + c.splits + c.relocations;
+        counters.splits += c.splits;
+        counters.collapses += c.collapses;
+        counters.flips += c.flips;
+      }
     }
 
     IterationStats row = measure(mesh, params.e_min, params.e_max, threads);

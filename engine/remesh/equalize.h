@@ -34,7 +34,8 @@ struct IterationStats {
   double seconds = 0;                  ///< wall time of this iteration
   double max_projection_distance = 0;  ///< largest distance a vertex moved in the projection
   /// Local fixes made by the interval cleanup (Params::cleanup) in this iteration; they are also
-  /// counted in splits, collapses and flips. Non-zero only in the last iteration.
+  /// counted in splits, collapses and flips. Non-zero once the mesh is nearly inside the interval
+  /// (and on open meshes, near the boundary, in every iteration).
   std::size_t cleanup_fixes = 0;
 };
 

@@ -17,6 +17,13 @@ std::vector<Vec3> snapshot_points(const TriMesh& mesh) {
 std::size_t undo_folds(TriMesh& mesh, const std::vector<Vec3>& before, unsigned threads) {
   const std::size_t nf = mesh.n_faces();
   std::vector<char> bad(nf, 0);
+  auto normal_before = [&](OpenMesh::FaceHandle f) {
+    OpenMesh::VertexHandle c[3];
+    geom::face_vertices(mesh, f, c);
+    return geom::cross_normal(before[c[0].idx()], before[c[1].idx()], before[c[2].idx()]);
+  };
+  // Folded: turned by more than 90 degrees, or folded onto a neighbour (kMinAdjacentCos);
+  // degenerate: a minimum angle below kMinAngle that it did not have before.
   auto face_is_bad = [&](OpenMesh::FaceHandle f) {
     if (mesh.status(f).deleted()) return false;
     OpenMesh::VertexHandle c[3];
@@ -24,9 +31,16 @@ std::size_t undo_folds(TriMesh& mesh, const std::vector<Vec3>& before, unsigned 
     const Vec3 &a0 = before[c[0].idx()], &b0 = before[c[1].idx()], &c0 = before[c[2].idx()];
     const Vec3 &a1 = mesh.point(c[0]), &b1 = mesh.point(c[1]), &c1 = mesh.point(c[2]);
     if (a0 == a1 && b0 == b1 && c0 == c1) return false;
-    if (!geom::normals_agree(geom::cross_normal(a0, b0, c0), geom::cross_normal(a1, b1, c1), 0.0)) return true;
+    const Vec3 n0 = geom::cross_normal(a0, b0, c0), n1 = geom::cross_normal(a1, b1, c1);
+    if (!geom::normals_agree(n0, n1, 0.0)) return true;
     const double floor_angle = std::min(geom::kMinAngle, geom::min_angle(a0, b0, c0));
-    return geom::min_angle(a1, b1, c1) < floor_angle;
+    if (geom::min_angle(a1, b1, c1) < floor_angle) return true;
+    for (auto h : mesh.fh_range(f)) {
+      const auto g = mesh.opposite_face_handle(h);
+      if (!g.is_valid()) continue;
+      if (!geom::adjacent_ok(n0, normal_before(g), n1, geom::face_normal(mesh, g))) return true;
+    }
+    return false;
   };
   parallel_for(nf, threads, [&](std::size_t i) { bad[i] = face_is_bad(mesh.face_handle(static_cast<unsigned>(i))); });
   std::vector<OpenMesh::FaceHandle> queue;

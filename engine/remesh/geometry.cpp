@@ -60,6 +60,15 @@ bool normals_agree(const Vec3& before, const Vec3& after, double min_cos) {
   return (before | after) > min_cos * nb * na;
 }
 
+bool adjacent_ok(const Vec3& f_before, const Vec3& g_before, const Vec3& f_after, const Vec3& g_after) {
+  const double na = f_after.norm() * g_after.norm();
+  if (!(na > 0)) return false;
+  const double cos_after = (f_after | g_after) / na;
+  if (cos_after >= kMinAdjacentCos) return true;
+  const double nb = f_before.norm() * g_before.norm();
+  return nb > 0 && cos_after >= (f_before | g_before) / nb;
+}
+
 void face_vertices(const TriMesh& mesh, OpenMesh::FaceHandle f, OpenMesh::VertexHandle out[3]) {
   auto h = mesh.halfedge_handle(f);
   out[0] = mesh.to_vertex_handle(h);
@@ -97,8 +106,30 @@ double star_min_angle(const TriMesh& mesh, OpenMesh::VertexHandle v) {
   return worst;
 }
 
+namespace {
+/// Normal of face f with vertex v moved to p.
+Vec3 moved_normal(const TriMesh& mesh, OpenMesh::FaceHandle f, OpenMesh::VertexHandle v, const Vec3& p) {
+  OpenMesh::VertexHandle c[3];
+  face_vertices(mesh, f, c);
+  Vec3 q[3];
+  for (int k = 0; k < 3; ++k) q[k] = c[k] == v ? p : mesh.point(c[k]);
+  return cross_normal(q[0], q[1], q[2]);
+}
+}  // namespace
+
 bool move_is_safe(const TriMesh& mesh, OpenMesh::VertexHandle v, const Vec3& p) {
   const double floor_angle = std::min(kMinAngle, star_min_angle(mesh, v));
+  // No fold between a face of the star and any of its neighbours.
+  for (auto h : mesh.voh_range(v)) {
+    const auto f = mesh.face_handle(h);
+    if (!f.is_valid()) continue;
+    for (auto g : {mesh.opposite_face_handle(h), mesh.opposite_face_handle(mesh.next_halfedge_handle(h))}) {
+      if (!g.is_valid()) continue;
+      if (!adjacent_ok(face_normal(mesh, f), face_normal(mesh, g), moved_normal(mesh, f, v, p),
+                       moved_normal(mesh, g, v, p)))
+        return false;
+    }
+  }
   for (auto f : mesh.vf_range(v)) {
     OpenMesh::VertexHandle c[3];
     face_vertices(mesh, f, c);

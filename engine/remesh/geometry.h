@@ -29,6 +29,14 @@ constexpr double kMinAngle = 1.0 * 3.14159265358979323846 / 180.0;
 /// Below it the edit folds or badly tilts the triangle and is refused.
 constexpr double kMinNormalCos = 0.5;
 
+/// Smallest cosine between the normals of two adjacent triangles an edit may leave (a dihedral
+/// angle of 60 degrees between them); an edit may keep a pair that was already sharper, not
+/// sharpen it further.
+constexpr double kMinAdjacentCos = -0.5;
+
+/// Is the pair of adjacent faces (unnormalised normals, before and after an edit) acceptable?
+bool adjacent_ok(const Vec3& f_before, const Vec3& g_before, const Vec3& f_after, const Vec3& g_after);
+
 /// True when `after` (unnormalised normal) agrees with `before`: both non-zero and the angle between
 /// them is below acos(min_cos).
 bool normals_agree(const Vec3& before, const Vec3& after, double min_cos = kMinNormalCos);

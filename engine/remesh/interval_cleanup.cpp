@@ -35,9 +35,12 @@ class Cleanup {
   }
 
   /// One round: every edge outside the interval, worst first.
-  std::size_t round(CleanupCounts& counts) {
+  std::size_t round(CleanupCounts& counts, bool boundary_only) {
     std::vector<std::pair<double, unsigned>> list;
     for (auto e : mesh_.edges()) {
+      if (boundary_only && !mesh_.is_boundary(mesh_.from_vertex_handle(mesh_.halfedge_handle(e, 0))) &&
+          !mesh_.is_boundary(mesh_.to_vertex_handle(mesh_.halfedge_handle(e, 0))))
+        continue;
       const double d = outside_by(mesh_.calc_edge_length(e));
       if (d > 0) list.emplace_back(-d, e.idx());
     }
@@ -141,8 +144,23 @@ class Cleanup {
     return n;
   }
 
+  /// Direction a boundary vertex may slide along (its boundary curve), or zero at a corner
+  /// (boundary turning by more than 30 degrees), where it must stay.
+  Vec3 boundary_tangent(VertexHandle v) const {
+    const HalfedgeHandle out = mesh_.halfedge_handle(v);  // the outgoing boundary halfedge
+    const Vec3 next = mesh_.point(mesh_.to_vertex_handle(out));
+    const Vec3 prev = mesh_.point(mesh_.from_vertex_handle(mesh_.prev_halfedge_handle(out)));
+    const Vec3 p = mesh_.point(v);
+    Vec3 a = p - prev, b = next - p;
+    if (!(a.norm() > 0) || !(b.norm() > 0)) return Vec3(0, 0, 0);
+    if ((a.normalized() | b.normalized()) < std::cos(M_PI / 6)) return Vec3(0, 0, 0);
+    return (next - prev).normalized();
+  }
+
   bool relocate(VertexHandle v) {
-    if (mesh_.is_boundary(v)) return false;
+    const bool boundary = mesh_.is_boundary(v);
+    const Vec3 tangent = boundary ? boundary_tangent(v) : Vec3(0, 0, 0);
+    if (boundary && tangent.sqrnorm() == 0) return false;
     const Vec3 start = mesh_.point(v);
     const Vec3 n = normal_at(v);
     const double margin = 0.05 * (e_max_ - e_min_);
@@ -161,10 +179,14 @@ class Cleanup {
         ++active;
       }
       if (active == 0) break;
-      grad -= n * (grad | n);
+      if (boundary) {
+        grad = tangent * (grad | tangent);  // slide along the boundary curve
+      } else {
+        grad -= n * (grad | n);  // stay in the tangent plane
+      }
       x -= grad * (1.0 / active);
     }
-    const Vec3 p = reference_.closest_point(x, n);
+    const Vec3 p = boundary ? reference_.closest_boundary_point(x) : reference_.closest_point(x, n);
     if (outside_around(v, p) >= outside_around(v, start)) return false;
     if (!geom::move_is_safe(mesh_, v, p)) return false;
     mesh_.point(v) = p;
@@ -185,14 +207,14 @@ class Cleanup {
 }  // namespace
 
 CleanupCounts interval_cleanup(TriMesh& mesh, const ReferenceSurface& reference, double e_min, double e_max,
-                               double flip_factor, int rounds) {
+                               double flip_factor, int rounds, bool boundary_only) {
   mesh.garbage_collection();
   Cleanup cleanup(mesh, reference, e_min, e_max, flip_factor);
   CleanupCounts counts;
   counts.outside_before = cleanup.count_outside();
   if (counts.outside_before > 0)
     for (int r = 0; r < rounds; ++r)
-      if (cleanup.round(counts) == 0) break;
+      if (cleanup.round(counts, boundary_only) == 0) break;
   counts.outside_after = cleanup.count_outside();
   return counts;
 }

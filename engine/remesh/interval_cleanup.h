@@ -31,7 +31,10 @@ struct CleanupCounts {
 };
 
 /// Runs the cleanup. Leaves the mesh garbage-collected. `flip_factor` is Params::flip_factor.
+/// With `boundary_only`, only edges with an end on the boundary are treated (see equalize.cpp: on
+/// open meshes this runs every iteration, because boundary vertices never move in the filter and
+/// split/collapse alone cannot even out a boundary whose edges are, say, 1.1 m long).
 CleanupCounts interval_cleanup(TriMesh& mesh, const ReferenceSurface& reference, double e_min, double e_max,
-                               double flip_factor, int rounds = 4);
+                               double flip_factor, int rounds = 4, bool boundary_only = false);
 
 }  // namespace remesh

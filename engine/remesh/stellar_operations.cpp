@@ -96,8 +96,20 @@ bool collapse_geometry_ok(const TriMesh& mesh, HalfedgeHandle h, const Vec3& p, 
       geom::face_vertices(mesh, f, c);
       Vec3 q[3];
       for (int k = 0; k < 3; ++k) q[k] = (c[k] == v0 || c[k] == v1) ? p : mesh.point(c[k]);
-      if (!geom::normals_agree(geom::face_normal(mesh, f), geom::cross_normal(q[0], q[1], q[2]))) return false;
+      const Vec3 n_after = geom::cross_normal(q[0], q[1], q[2]);
+      if (!geom::normals_agree(geom::face_normal(mesh, f), n_after)) return false;
       if (geom::min_angle(q[0], q[1], q[2]) < floor_angle) return false;
+      // No fold against a neighbour (those across the removed faces are not checked).
+      for (auto g : mesh.ff_range(f)) {
+        if (g == gone0 || g == gone1) continue;
+        VertexHandle d[3];
+        geom::face_vertices(mesh, g, d);
+        Vec3 r[3];
+        for (int k = 0; k < 3; ++k) r[k] = (d[k] == v0 || d[k] == v1) ? p : mesh.point(d[k]);
+        if (!geom::adjacent_ok(geom::face_normal(mesh, f), geom::face_normal(mesh, g), n_after,
+                               geom::cross_normal(r[0], r[1], r[2])))
+          return false;
+      }
     }
     for (auto w : mesh.vv_range(end)) {
       if (w == v0 || w == v1) continue;

@@ -65,6 +65,21 @@ bool flip_is_safe(const TriMesh& mesh, EdgeHandle e, double f) {
   const Vec3 new_a = geom::cross_normal(p3, p1, p2), new_b = geom::cross_normal(p2, p0, p3);
   for (const Vec3& n : {new_a, new_b})
     if (!geom::normals_agree(old_a, n) || !geom::normals_agree(old_b, n)) return false;
+  if (!geom::adjacent_ok(old_a, old_b, new_a, new_b)) return false;
+  // The four outer neighbours against the new face that takes over their shared edge.
+  const HalfedgeHandle h0 = mesh.halfedge_handle(e, 0), h1 = mesh.halfedge_handle(e, 1);
+  const std::pair<HalfedgeHandle, int> outer[4] = {{mesh.next_halfedge_handle(h0), 0},
+                                                   {mesh.next_halfedge_handle(mesh.next_halfedge_handle(h1)), 1},
+                                                   {mesh.next_halfedge_handle(mesh.next_halfedge_handle(h0)), 2},
+                                                   {mesh.next_halfedge_handle(h1), 3}};
+  for (const auto& [h, k] : outer) {
+    const auto g = mesh.opposite_face_handle(h);
+    if (!g.is_valid()) continue;
+    const Vec3 ng = geom::face_normal(mesh, g);
+    const Vec3& old_f = (k == 0 || k == 2) ? old_a : old_b;
+    const Vec3& new_f = k < 2 ? new_a : new_b;
+    if (!geom::adjacent_ok(old_f, ng, new_f, ng)) return false;
+  }
   const double before = std::min(geom::min_angle(p0, p1, p2), geom::min_angle(p1, p0, p3));
   const double after = std::min(geom::min_angle(p3, p1, p2), geom::min_angle(p2, p0, p3));
   return after >= f * before && after >= std::min(geom::kMinAngle, before);

@@ -1,0 +1,211 @@
+// The whole of Algorithm 1 on small generated meshes: interval, topology, validity, statistics,
+// cancellation, determinism.
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <stop_token>
+#include <vector>
+
+#include "remesh/equalize.h"
+#include "support/mesh_generators.h"
+#include "test_helpers.h"
+
+using namespace remesh;
+
+namespace {
+
+Params table_4_2(int iterations = 100) {
+  Params p;
+  p.e_min = 1.2;
+  p.e_max = 1.8;
+  p.iterations = iterations;
+  return p;
+}
+
+struct Topology {
+  long euler;
+  std::size_t loops, components;
+  bool operator==(const Topology&) const = default;
+};
+
+Topology topology(const TriMesh& m) {
+  return {test::euler_characteristic(m), test::count_boundary_loops(m), test::count_components(m)};
+}
+
+/// Remeshes and checks what must hold for any input: valid, same topology.
+IterationStats remesh_and_check(TriMesh& mesh, const Params& p) {
+  const Topology before = topology(mesh);
+  IterationStats last;
+  equalize(mesh, p, [&](const IterationStats& s) { last = s; });
+  CHECK(test::check_mesh_valid(mesh) == "");
+  CHECK(topology(mesh) == before);
+  return last;
+}
+
+}  // namespace
+
+TEST_CASE("refinement and simplification reach 99 % inside on a sphere and a torus", "[equalize]") {
+  struct Case {
+    const char* name;
+    TriMesh mesh;
+    double mean;
+  };
+  std::vector<Case> cases;
+  cases.push_back({"sphere refine", test::make_icosphere(3), 2.25});
+  cases.push_back({"sphere simplify", test::make_icosphere(4), 0.75});
+  cases.push_back({"torus refine", test::make_torus(40, 16, 3.0, 1.0), 2.25});
+  cases.push_back({"torus simplify", test::make_torus(80, 32, 3.0, 1.0), 0.75});
+  for (auto& c : cases) {
+    INFO(c.name);
+    test::scale_mean_edge(c.mesh, c.mean);
+    remesh_and_check(c.mesh, table_4_2(60));
+    CHECK(test::plain_inside_fraction(c.mesh, 1.2, 1.8) >= 0.99);
+    const double mean = test::plain_mean_edge(c.mesh);
+    CHECK(mean > 1.3);
+    CHECK(mean < 1.7);
+  }
+}
+
+TEST_CASE("topology is unchanged on open and high-genus meshes", "[equalize]") {
+  SECTION("open grid, one boundary loop") {
+    TriMesh mesh = test::make_open_grid(16, 12, 1.0);
+    test::scale_mean_edge(mesh, 2.25);
+    remesh_and_check(mesh, table_4_2(40));
+    CHECK(test::count_boundary_loops(mesh) == 1);
+    CHECK(test::plain_inside_fraction(mesh, 1.2, 1.8) >= 0.97);
+    // Boundary vertices stay on the boundary of the flat patch (z = 0, on the rectangle's sides).
+    for (auto v : mesh.vertices()) CHECK(std::abs(mesh.point(v)[2]) < 1e-9);
+  }
+  SECTION("double torus (genus 2, sharp voxel edges), refinement and simplification") {
+    for (double mean : {2.25, 0.75}) {
+      TriMesh mesh = test::make_double_torus(1.0, 3);
+      test::scale_mean_edge(mesh, mean);
+      remesh_and_check(mesh, table_4_2(30));
+      CHECK(test::euler_characteristic(mesh) == -2);
+    }
+  }
+  SECTION("two components, one of them tetrahedron-sized") {
+    TriMesh mesh = test::make_icosphere(3, 1.0);
+    test::scale_mean_edge(mesh, 0.75);
+    // A small tetrahedron far away: simplification must not make it vanish.
+    auto a = mesh.add_vertex(Vec3(100, 0, 0)), b = mesh.add_vertex(Vec3(100.5, 0, 0)),
+         c = mesh.add_vertex(Vec3(100, 0.5, 0)), d = mesh.add_vertex(Vec3(100, 0, 0.5));
+    mesh.add_face(a, c, b);
+    mesh.add_face(a, b, d);
+    mesh.add_face(b, c, d);
+    mesh.add_face(a, d, c);
+    remesh_and_check(mesh, table_4_2(20));
+    CHECK(test::count_components(mesh) == 2);
+  }
+}
+
+TEST_CASE("statistics rows equal a recomputation from the output mesh", "[equalize]") {
+  TriMesh mesh = test::make_torus(30, 12, 3.0, 1.0);
+  test::scale_mean_edge(mesh, 2.25);
+  Params p = table_4_2(6);
+  p.run_all_iterations = true;
+  std::vector<IterationStats> rows;
+  equalize(mesh, p, [&](const IterationStats& s) { rows.push_back(s); });
+  REQUIRE(rows.size() == 6);
+  for (std::size_t i = 0; i < rows.size(); ++i) CHECK(rows[i].iteration == static_cast<int>(i + 1));
+  const IterationStats& last = rows.back();
+
+  std::vector<double> lengths;
+  for (auto e : mesh.edges()) lengths.push_back(mesh.calc_edge_length(e));
+  double sum = 0;
+  std::size_t small = 0, big = 0;
+  for (double l : lengths) {
+    sum += l;
+    small += l < 1.2;
+    big += l > 1.8;
+  }
+  const double mean = sum / static_cast<double>(lengths.size());
+  double var = 0;
+  for (double l : lengths) var += (l - mean) * (l - mean);
+  std::size_t interior = 0, regular = 0;
+  for (auto v : mesh.vertices()) {
+    if (mesh.is_boundary(v)) continue;
+    ++interior;
+    regular += mesh.valence(v) == 6;
+  }
+  CHECK(last.vertices == mesh.n_vertices());
+  CHECK(last.edges == lengths.size());
+  CHECK(last.mean == Approx(mean).epsilon(1e-12));
+  CHECK(last.deviation == Approx(std::sqrt(var / static_cast<double>(lengths.size()))).epsilon(1e-9));
+  CHECK(last.regular_percent == Approx(100.0 * static_cast<double>(regular) / static_cast<double>(interior)));
+  CHECK(last.small == small);
+  CHECK(last.big == big);
+  CHECK(last.inside_fraction == Approx(static_cast<double>(lengths.size() - small - big) / static_cast<double>(lengths.size())));
+  std::size_t operations = 0;
+  for (const auto& r : rows) {
+    operations += r.splits + r.collapses + r.flips;
+    CHECK(r.seconds >= 0);
+    CHECK(r.max_projection_distance >= 0);
+  }
+  CHECK(operations > 0);
+}
+
+TEST_CASE("cancelling returns a valid mesh and Outcome::Cancelled", "[equalize]") {
+  TriMesh mesh = test::make_icosphere(3);
+  test::scale_mean_edge(mesh, 2.25);
+  std::stop_source source;
+  int seen = 0;
+  Params p = table_4_2(50);
+  p.run_all_iterations = true;
+  const Result r = equalize(mesh, p, [&](const IterationStats& s) {
+    seen = s.iteration;
+    if (s.iteration == 3) source.request_stop();
+  }, source.get_token());
+  CHECK(r.outcome == Outcome::Cancelled);
+  CHECK(r.iterations_done == 3);
+  CHECK(seen == 3);
+  CHECK(test::check_mesh_valid(mesh) == "");
+  CHECK(test::euler_characteristic(mesh) == 2);
+
+  std::stop_source early;
+  early.request_stop();
+  TriMesh untouched = test::make_icosphere(2);
+  CHECK(equalize(untouched, table_4_2(), {}, early.get_token()).outcome == Outcome::Cancelled);
+  CHECK(test::check_mesh_valid(untouched) == "");
+}
+
+TEST_CASE("convergence stops early unless all iterations are asked for", "[equalize]") {
+  TriMesh mesh = test::make_icosphere(3);
+  test::scale_mean_edge(mesh, 1.5);
+  const Result r = equalize(mesh, table_4_2(100));
+  if (r.outcome == Outcome::Converged) {
+    CHECK(r.iterations_done < 100);
+    CHECK(test::plain_inside_fraction(mesh, 1.2, 1.8) == 1.0);
+  } else {
+    CHECK(r.outcome == Outcome::Completed);
+    CHECK(r.iterations_done == 100);
+  }
+  TriMesh again = test::make_icosphere(3);
+  test::scale_mean_edge(again, 1.5);
+  Params all = table_4_2(12);
+  all.run_all_iterations = true;
+  const Result r2 = equalize(again, all);
+  CHECK(r2.outcome == Outcome::Completed);
+  CHECK(r2.iterations_done == 12);
+}
+
+TEST_CASE("the same input gives bit-identical output with 1 and 2 threads", "[equalize]") {
+  auto run = [](unsigned threads) {
+    TriMesh mesh = test::make_torus(36, 14, 3.0, 1.0);
+    test::scale_mean_edge(mesh, 2.25);
+    Params p = table_4_2(15);
+    p.threads = threads;
+    equalize(mesh, p);
+    return mesh;
+  };
+  const TriMesh a = run(1), b = run(2);
+  REQUIRE(a.n_vertices() == b.n_vertices());
+  REQUIRE(a.n_faces() == b.n_faces());
+  for (auto v : a.vertices()) CHECK(a.point(v) == b.point(b.vertex_handle(v.idx())));
+  for (auto f : a.faces()) {
+    auto fb = b.face_handle(f.idx());
+    auto ia = a.cfv_begin(f);
+    auto ib = b.cfv_begin(fb);
+    for (int k = 0; k < 3; ++k, ++ia, ++ib) CHECK(ia->idx() == ib->idx());
+  }
+}

@@ -1,0 +1,268 @@
+// Each step of Algorithm 1 alone.
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <random>
+
+#include "remesh/geometry.h"
+#include "remesh/low_pass_filter.h"
+#include "remesh/projection.h"
+#include "remesh/reference_surface.h"
+#include "remesh/reposition.h"
+#include "remesh/stellar_operations.h"
+#include "remesh/valence_flips.h"
+#include "support/mesh_generators.h"
+
+using namespace remesh;
+using OpenMesh::EdgeHandle;
+
+namespace {
+
+TriMesh tetrahedron() {
+  TriMesh m;
+  auto a = m.add_vertex(Vec3(0, 0, 0)), b = m.add_vertex(Vec3(1, 0, 0)), c = m.add_vertex(Vec3(0, 1, 0)),
+       d = m.add_vertex(Vec3(0, 0, 1));
+  m.add_face(a, c, b);
+  m.add_face(a, b, d);
+  m.add_face(b, c, d);
+  m.add_face(a, d, c);
+  return m;
+}
+
+/// Independent area-weighted vertex normal.
+Vec3 normal_of(const TriMesh& m, OpenMesh::VertexHandle v) {
+  Vec3 n(0, 0, 0);
+  for (auto f : m.vf_range(v)) {
+    Vec3 p[3];
+    int k = 0;
+    for (auto w : m.fv_range(f)) p[k++] = m.point(w);
+    n += (p[1] - p[0]) % (p[2] - p[0]);
+  }
+  return n.normalize();
+}
+
+/// Smallest angle of the two faces of edge e, by the law of cosines (independent of geometry.cpp).
+double two_face_min_angle(const TriMesh& m, EdgeHandle e) {
+  double best = M_PI;
+  for (int s = 0; s < 2; ++s) {
+    auto f = m.face_handle(m.halfedge_handle(e, s));
+    Vec3 p[3];
+    int k = 0;
+    for (auto w : m.fv_range(f)) p[k++] = m.point(w);
+    for (int i = 0; i < 3; ++i) {
+      const Vec3 u = p[(i + 1) % 3] - p[i], w = p[(i + 2) % 3] - p[i];
+      best = std::min(best, std::acos(std::clamp((u | w) / (u.norm() * w.norm()), -1.0, 1.0)));
+    }
+  }
+  return best;
+}
+
+}  // namespace
+
+TEST_CASE("splits and collapses keep the mesh valid and its topology", "[steps]") {
+  TriMesh mesh = test::make_icosphere(3, 10.0);
+  const long euler = test::euler_characteristic(mesh);
+  ComponentSizes sizes(mesh);
+  std::size_t splits = 0, collapses = 0;
+  for (unsigned i = 0; i < mesh.n_edges(); i += 7) {
+    if (split_edge(mesh, mesh.edge_handle(i), 1.0, sizes).is_valid()) ++splits;
+  }
+  for (unsigned i = 0; i < mesh.n_edges(); i += 5) {
+    const EdgeHandle e = mesh.edge_handle(i);
+    if (mesh.status(e).deleted()) continue;
+    CollapsePlan plan;
+    if (plan_collapse(mesh, e, 1.0, 1e9, sizes, plan)) {
+      apply_collapse(mesh, plan, sizes);
+      ++collapses;
+    }
+  }
+  mesh.garbage_collection();
+  CHECK(splits > 50);
+  CHECK(collapses > 50);
+  CHECK(test::check_mesh_valid(mesh) == "");
+  CHECK(test::euler_characteristic(mesh) == euler);
+  CHECK(test::count_components(mesh) == 1);
+}
+
+TEST_CASE("boundary collapses stay on the boundary and never pinch", "[steps]") {
+  TriMesh mesh = test::make_open_grid(8, 8, 1.0);
+  ComponentSizes sizes(mesh);
+  std::size_t boundary_collapses = 0;
+  for (auto e : mesh.edges()) {
+    if (mesh.status(e).deleted()) continue;
+    const auto h = mesh.halfedge_handle(e, 0);
+    const auto v0 = mesh.from_vertex_handle(h), v1 = mesh.to_vertex_handle(h);
+    CollapsePlan plan;
+    if (!mesh.is_boundary(e) && mesh.is_boundary(v0) && mesh.is_boundary(v1)) {
+      CHECK_FALSE(plan_collapse(mesh, e, 1.0, 1e9, sizes, plan));
+    } else if (mesh.is_boundary(e) && plan_collapse(mesh, e, 1.0, 1e9, sizes, plan)) {
+      // The kept vertex lies on the collapsed boundary edge.
+      const Vec3 a = mesh.point(v0), b = mesh.point(v1);
+      CHECK(((plan.position - a) % (b - a)).norm() < 1e-9);
+      apply_collapse(mesh, plan, sizes);
+      ++boundary_collapses;
+    }
+  }
+  mesh.garbage_collection();
+  CHECK(boundary_collapses > 5);
+  CHECK(test::check_mesh_valid(mesh) == "");
+  CHECK(test::count_boundary_loops(mesh) == 1);
+  CHECK(test::euler_characteristic(mesh) == 1);
+  for (auto v : mesh.vertices())
+    if (mesh.is_boundary(v)) CHECK(std::abs(mesh.point(v)[2]) < 1e-12);
+}
+
+TEST_CASE("an interior edge between two boundary vertices is never collapsed", "[steps]") {
+  TriMesh strip = test::make_open_grid(1, 6, 1.0);  // every vertex on the boundary
+  ComponentSizes sizes(strip);
+  std::size_t interior = 0;
+  for (auto e : strip.edges()) {
+    if (strip.is_boundary(e)) continue;
+    ++interior;
+    CollapsePlan plan;
+    CHECK_FALSE(plan_collapse(strip, e, 10.0, 1e9, sizes, plan));
+  }
+  CHECK(interior >= 6);
+}
+
+TEST_CASE("a tetrahedron does not collapse away", "[steps]") {
+  TriMesh mesh = tetrahedron();
+  ComponentSizes sizes(mesh);
+  for (auto e : mesh.edges()) {
+    CollapsePlan plan;
+    CHECK_FALSE(plan_collapse(mesh, e, 10.0, 1e9, sizes, plan));
+  }
+}
+
+TEST_CASE("eq. 3.1 places the vertex at the minimiser", "[steps]") {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(-2, 2);
+  for (int trial = 0; trial < 50; ++trial) {
+    const Vec3 a(u(rng), u(rng), u(rng)), b(u(rng), u(rng), u(rng));
+    std::vector<Vec3> neighbours;
+    for (int k = 0; k < 3 + trial % 6; ++k) neighbours.emplace_back(u(rng), u(rng), u(rng));
+    const double target = 1.0 + 0.02 * trial;
+    const double t = equalizing_parameter(a, b, neighbours, target);
+    REQUIRE(t >= 0.0);
+    REQUIRE(t <= 1.0);
+    // Brute force, recomputing E(t) here.
+    auto energy = [&](double s) {
+      const Vec3 p = a + (b - a) * s;
+      double e = 0;
+      for (const Vec3& v : neighbours) e += ((p - v).norm() - target) * ((p - v).norm() - target);
+      return e;
+    };
+    double best = energy(0);
+    for (int i = 1; i <= 20000; ++i) best = std::min(best, energy(i / 20000.0));
+    CHECK(energy(t) <= best + 1e-6);
+  }
+}
+
+TEST_CASE("a flip is kept only under the valence-and-angle rule", "[steps]") {
+  for (double f : {0.0, 0.5, 0.9}) {
+    TriMesh mesh = test::make_open_grid(10, 10, 1.0);  // interior valences 4 and 8
+    std::mt19937 rng(3);
+    std::uniform_real_distribution<double> jitter(-0.2, 0.2);
+    for (auto v : mesh.vertices())
+      if (!mesh.is_boundary(v)) mesh.point(v) += Vec3(jitter(rng), jitter(rng), 0);
+    std::size_t accepted = 0;
+    for (auto e : mesh.edges()) {
+      if (mesh.is_boundary(e)) {
+        CHECK_FALSE(flip_improves(mesh, e, f));
+        continue;
+      }
+      // The rule, recomputed on a flipped copy.
+      auto h0 = mesh.halfedge_handle(e, 0), h1 = mesh.halfedge_handle(e, 1);
+      OpenMesh::VertexHandle q[4] = {mesh.from_vertex_handle(h0), mesh.to_vertex_handle(h0),
+                                     mesh.to_vertex_handle(mesh.next_halfedge_handle(h0)),
+                                     mesh.to_vertex_handle(mesh.next_halfedge_handle(h1))};
+      auto dev = [&](const TriMesh& m) {
+        int d = 0;
+        for (auto v : q) d += std::abs(static_cast<int>(m.valence(v)) - (m.is_boundary(v) ? 4 : 6));
+        return d;
+      };
+      const bool says = flip_improves(mesh, e, f);
+      if (!mesh.is_flip_ok(e)) {
+        CHECK_FALSE(says);
+        continue;
+      }
+      TriMesh copy = mesh;
+      const int dev_before = dev(copy);
+      const double angle_before = two_face_min_angle(copy, e);
+      copy.flip(e);
+      const bool rule = dev(copy) < dev_before && two_face_min_angle(copy, e) >= f * angle_before - 1e-12;
+      if (says) {
+        CHECK(rule);
+        ++accepted;
+      }
+    }
+    CHECK(accepted > 0);
+    std::size_t flips = valence_flips(mesh, f, 3);
+    CHECK(flips > 0);
+    CHECK(test::check_mesh_valid(mesh) == "");
+  }
+}
+
+TEST_CASE("the filter moves vertices tangentially only and never moves boundary vertices", "[steps]") {
+  SECTION("open flat patch") {
+    TriMesh mesh = test::make_open_grid(12, 12, 1.0);
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<double> jitter(-0.25, 0.25);
+    for (auto v : mesh.vertices())
+      if (!mesh.is_boundary(v)) mesh.point(v) += Vec3(jitter(rng), jitter(rng), 0);
+    TriMesh before = mesh;
+    for (int rings : {1, 2, 3}) {
+      const auto moves = low_pass_displacements(mesh, rings, 2);
+      for (auto v : mesh.vertices()) {
+        if (mesh.is_boundary(v)) CHECK(moves[v.idx()].norm() == 0.0);
+        CHECK(std::abs(moves[v.idx()][2]) < 1e-12);
+      }
+    }
+    low_pass_filter(mesh, 2, 2);
+    std::size_t moved = 0;
+    for (auto v : mesh.vertices()) {
+      if (mesh.is_boundary(v)) CHECK(mesh.point(v) == before.point(v));
+      else moved += (mesh.point(v) - before.point(v)).norm() > 1e-6;
+    }
+    CHECK(moved > 50);
+  }
+  SECTION("curved closed surface") {
+    TriMesh mesh = test::make_torus(30, 15, 3.0, 1.0);
+    const auto moves = low_pass_displacements(mesh, 2, 2);
+    double largest = 0;
+    for (auto v : mesh.vertices()) {
+      CHECK(std::abs(moves[v.idx()] | normal_of(mesh, v)) < 1e-9 * (1 + moves[v.idx()].norm()));
+      largest = std::max(largest, moves[v.idx()].norm());
+    }
+    CHECK(largest > 1e-4);
+  }
+}
+
+TEST_CASE("projection lands on the reference surface", "[steps]") {
+  const TriMesh sphere = test::make_icosphere(4, 1.0);  // edge ~0.077: chord error < 1e-3
+  const ReferenceSurface reference(sphere);
+  std::mt19937 rng(11);
+  std::normal_distribution<double> g(0, 1);
+  std::uniform_real_distribution<double> r(0.9, 1.1);
+  for (int i = 0; i < 500; ++i) {
+    Vec3 d(g(rng), g(rng), g(rng));
+    d.normalize();
+    const Vec3 p = d * r(rng);
+    const Vec3 c = reference.closest_point(p, d);
+    CHECK(std::abs(c.norm() - 1.0) < 2e-3);
+    CHECK((c - d).norm() < 0.08);  // near the radial projection
+    // Nothing on the sphere mesh is closer than c (brute force over all triangles).
+    double best = 1e9;
+    for (auto f : sphere.faces()) {
+      Vec3 q[3];
+      int k = 0;
+      for (auto v : sphere.fv_range(f)) q[k++] = sphere.point(v);
+      best = std::min(best, (geom::closest_point_on_triangle(p, q[0], q[1], q[2]) - p).norm());
+    }
+    CHECK((c - p).norm() <= best + 1e-12);
+  }
+  TriMesh mesh = test::make_icosphere(2, 1.07);
+  const double moved = project_onto_reference(mesh, reference, 2);
+  CHECK(moved > 0.05);
+  for (auto v : mesh.vertices()) CHECK(std::abs(mesh.point(v).norm() - 1.0) < 2e-3);
+}

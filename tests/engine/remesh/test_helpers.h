@@ -1,0 +1,19 @@
+#pragma once
+/// Helpers of the remesher tests, computed independently of the engine's own statistics.
+
+#include <cstddef>
+
+#include "core/mesh.h"
+
+namespace remesh::test {
+
+/// Mean length of the mesh's edges (plain loop).
+double plain_mean_edge(const TriMesh& mesh);
+
+/// Scales about the origin so the mean edge length becomes `mean`.
+void scale_mean_edge(TriMesh& mesh, double mean);
+
+/// Fraction of edges with length in [lo, hi].
+double plain_inside_fraction(const TriMesh& mesh, double lo, double hi);
+
+}  // namespace remesh::test
