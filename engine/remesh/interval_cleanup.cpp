@@ -65,8 +65,11 @@ class Cleanup {
       }
       ++fixes;
     }
-    mesh_.garbage_collection();
-    sizes_ = ComponentSizes(mesh_);
+    if (collapsed_) {  // only collapses leave deleted elements; collecting renumbers, so recount
+      mesh_.garbage_collection();
+      sizes_ = ComponentSizes(mesh_);
+      collapsed_ = false;
+    }
     return fixes;
   }
 
@@ -103,6 +106,7 @@ class Cleanup {
         if (w != kept && w != removed && !inside((mesh_.point(w) - p).norm())) return false;
     plan.position = p;
     apply_collapse(mesh_, plan, sizes_);
+    collapsed_ = true;
     return true;
   }
 
@@ -193,22 +197,29 @@ class Cleanup {
     return true;
   }
 
+  /// Relocates an end of e, else a vertex opposite e (moving it changes the triangles around e, and
+  /// often lets the next pass fix e by an end).
   bool try_relocate(EdgeHandle e) {
     const HalfedgeHandle h = mesh_.halfedge_handle(e, 0);
-    return relocate(mesh_.from_vertex_handle(h)) || relocate(mesh_.to_vertex_handle(h));
+    if (relocate(mesh_.from_vertex_handle(h)) || relocate(mesh_.to_vertex_handle(h))) return true;
+    for (int s = 0; s < 2; ++s) {
+      const HalfedgeHandle g = mesh_.halfedge_handle(e, s);
+      if (!mesh_.is_boundary(g) && relocate(mesh_.to_vertex_handle(mesh_.next_halfedge_handle(g)))) return true;
+    }
+    return false;
   }
 
   TriMesh& mesh_;
   const ReferenceSurface& reference_;
   double e_min_, e_max_, f_;
   ComponentSizes sizes_;
+  bool collapsed_ = false;
 };
 
 }  // namespace
 
 CleanupCounts interval_cleanup(TriMesh& mesh, const ReferenceSurface& reference, double e_min, double e_max,
                                double flip_factor, int rounds, bool boundary_only) {
-  mesh.garbage_collection();
   Cleanup cleanup(mesh, reference, e_min, e_max, flip_factor);
   CleanupCounts counts;
   counts.outside_before = cleanup.count_outside();

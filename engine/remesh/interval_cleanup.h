@@ -30,7 +30,8 @@ struct CleanupCounts {
   std::size_t outside_before = 0, outside_after = 0;  ///< edges outside [e_min, e_max]
 };
 
-/// Runs the cleanup. Leaves the mesh garbage-collected. `flip_factor` is Params::flip_factor.
+/// Runs the cleanup. Precondition: no deleted elements (garbage-collected); it leaves the mesh
+/// garbage-collected too. `flip_factor` is Params::flip_factor.
 /// With `boundary_only`, only edges with an end on the boundary are treated (see equalize.cpp: on
 /// open meshes this runs every iteration, because boundary vertices never move in the filter and
 /// split/collapse alone cannot even out a boundary whose edges are, say, 1.1 m long).
