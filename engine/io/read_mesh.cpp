@@ -12,6 +12,11 @@ namespace remesh {
 LoadedMesh read_mesh(std::string_view bytes, const ReadOptions& options) {
   if (bytes.empty()) throw MeshError("empty input: no bytes to read");
   std::optional<Format> format = options.format ? options.format : detect_format(bytes);
+  // .gltf and .glb are often confused by clients: trust the content when it is clearly one of them.
+  if (format == Format::Gltf || format == Format::Glb) {
+    const std::optional<Format> sniffed = detect_format(bytes);
+    if (sniffed == Format::Gltf || sniffed == Format::Glb) format = sniffed;
+  }
   if (!format) throw MeshError("unrecognised mesh format (supported: OBJ, OFF, PLY, STL, glTF, GLB)");
   io::RawSoup soup;
   switch (*format) {
@@ -35,14 +40,7 @@ LoadedMesh read_mesh_file(const std::string& path, ReadOptions options) {
   buffer << in.rdbuf();
   if (in.bad()) throw MeshError("cannot read '" + path + "'");
   const std::string bytes = std::move(buffer).str();
-  if (!options.format) {
-    options.format = parse_format(path);
-    // A .gltf may be GLB in disguise and vice versa; trust the content when it is clear.
-    if (options.format == Format::Gltf || options.format == Format::Glb) {
-      auto sniffed = detect_format(bytes);
-      if (sniffed == Format::Gltf || sniffed == Format::Glb) options.format = sniffed;
-    }
-  }
+  if (!options.format) options.format = parse_format(path);
   if (bytes.empty()) throw MeshError("'" + path + "' is empty");
   return read_mesh(bytes, options);
 }

@@ -187,3 +187,9 @@ TEST_CASE("Format detection and names") {
   }
   CHECK(mime_type(Format::Glb) == "model/gltf-binary");
 }
+
+TEST_CASE("glTF and GLB given under each other's name are read by their content") {
+  PolygonSoup soup = to_soup(test::make_icosphere(1));
+  CHECK(read_as(write_mesh(soup, Format::Glb), Format::Gltf).format == Format::Glb);
+  CHECK(read_as(test::write_gltf_data_uri(soup), Format::Glb).format == Format::Gltf);
+}
