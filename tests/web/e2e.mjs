@@ -76,7 +76,12 @@ async function main() {
     .then((e) => e.textContent()).catch(() => '');
   check(/iterations/.test(iter_error), `server's 422 for iterations shown beside the field ("${iter_error}")`);
 
-  // --- the real job: refine to 0.6 x mean, 4 iterations, all of them ---
+  // --- a long job started over the API (as with curl) holds the only worker, so the page's job
+  // waits in the queue with its event stream open and every row of it must arrive live ---
+  const blocker = await api_post_job(base, icosphere_obj(4), { emin: 0.01, emax: 0.02, iterations: 1000, run_all_iterations: true });
+  check(await wait_state(base, blocker, ['running']), `API job ${blocker} running`);
+
+  // --- the page's job: refine to 0.6 x mean, 4 iterations, all of them ---
   await page.fill('#target', String(+(0.6 * mean).toPrecision(4)));
   await page.click('#apply-target');
   await page.fill('#iterations', '4');
@@ -85,6 +90,16 @@ async function main() {
   await page.waitForFunction(() => /job=/.test(location.hash), null, { timeout: 10000 });
   const job_id = await page.evaluate(() => decodeURIComponent(/job=([^&]+)/.exec(location.hash)[1]));
   check(await page.waitForSelector('#summary dd', { timeout: 10000 }).then(() => true, () => false), 'input summary shown');
+  const streaming = await page.waitForFunction(() => window.__remeshd.view.source?.readyState === 1, null, { timeout: 10000 })
+    .then(() => true, () => false);
+  check(streaming && (await page.textContent('#job-state')) === 'queued', 'queued job: state shown, event stream open');
+  await page.click('#jobs-refresh');
+  const blocker_row = await page.waitForSelector(`#jobs li[data-id="${blocker}"] .state.running`, { timeout: 10000 })
+    .then(() => true, () => false);
+  check(blocker_row, 'the API-started job is listed as running in the recent jobs');
+  await shot('0-queued');
+  const cancel = await fetch(`${base}/api/v1/jobs/${blocker}`, { method: 'DELETE' });
+  check(cancel.status === 202, `API job cancelled (DELETE answered ${cancel.status})`);
   await page.waitForSelector('#job-state.succeeded, #job-state.failed, #job-state.cancelled', { timeout: 30000 });
   const final_state = await page.textContent('#job-state');
   check(final_state === 'succeeded', `job ${job_id} succeeded (state ${final_state})`);
@@ -92,6 +107,9 @@ async function main() {
   const rows = Array.isArray(api_rows) ? api_rows : api_rows.rows || [];
   const table_rows = await page.$$eval('#rows tbody tr', (trs) => trs.length);
   check(rows.length === 4 && table_rows === rows.length, `table holds every row (${table_rows} in page, ${rows.length} from /stats)`);
+  const streamed = await page.evaluate(() => window.__remeshd.view.streamed);
+  check(streamed === rows.length, `every row arrived live over the event stream (${streamed} of ${rows.length})`);
+  check(await wait_state(base, blocker, ['cancelled']), 'the API job ended cancelled');
   const summary_text = await page.textContent('#summary');
   check(/server summary/.test(summary_text) && /genus/.test(summary_text), 'server summary with genus replaces the local one');
 
@@ -146,6 +164,26 @@ async function main() {
   await shot('4-garbage');
 
   check(console_errors.length === 0, `no errors in the browser console${console_errors.length ? `: ${console_errors.join(' | ')}` : ''}`);
+}
+
+/// POSTs a job as multipart (what curl -F does); returns its id.
+async function api_post_job(base, obj_text, params) {
+  const form = new FormData();
+  form.append('mesh', new Blob([obj_text]), 'api_sphere.obj');
+  form.append('params', JSON.stringify(params));
+  const res = await fetch(`${base}/api/v1/jobs`, { method: 'POST', body: form });
+  if (res.status !== 202) throw new Error(`POST /jobs answered ${res.status}: ${await res.text()}`);
+  return (await res.json()).id;
+}
+
+/// Polls the job until its state is one of `states` (true) or 20 s pass (false).
+async function wait_state(base, id, states) {
+  for (let i = 0; i < 200; ++i) {
+    const job = await (await fetch(`${base}/api/v1/jobs/${id}`)).json();
+    if (states.includes(job.state)) return true;
+    await new Promise((r) => setTimeout(r, 100));
+  }
+  return false;
 }
 
 async function free_port() {

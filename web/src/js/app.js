@@ -87,7 +87,10 @@ async function choose_file(file) {
   $('submit-status').textContent = '';
   for (const name of ['input', 'remeshed', 'dual']) state.viewer?.forget(name);
   set_available(['input']);
+  $('show-input').checked = true;
+  params.set_input_mean(NaN);
   state.input_of = null;
+  state.watched = null;
   if (!['obj', 'off', 'ply', 'stl', 'gltf', 'glb'].includes(format_of(file.name))) {
     status(`".${format_of(file.name)}" is not a mesh format remeshd reads; the server will say more.`);
     return;
@@ -254,6 +257,7 @@ function reset_job_panel() {
   $('downloads').replaceChildren();
   $('rows').tBodies[0].replaceChildren();
   view.rows = [];
+  view.job = null;
   view.draw_rows();
 }
 

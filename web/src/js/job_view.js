@@ -51,6 +51,8 @@ export class JobView {
   async watch(id) {
     this.stop();
     const generation = ++this.generation;
+    this.ended_id = null;
+    this.streamed = 0;  // rows that arrived over the event stream (the rest came from /stats)
     this.rows = [];
     $('rows').tBodies[0].replaceChildren();
     this.draw_rows();
@@ -77,7 +79,7 @@ export class JobView {
     const last = this.rows.length ? this.rows[this.rows.length - 1].iteration : 0;
     const es = api.events(id, last);
     this.source = es;
-    es.addEventListener('iteration', (e) => this.add_rows([JSON.parse(e.data)]));
+    es.addEventListener('iteration', (e) => { this.streamed += this.add_rows([JSON.parse(e.data)]); });
     es.addEventListener('state', (e) => {
       const { state } = JSON.parse(e.data);
       if (this.job && state) { this.job.state = state; this.render_head(); }
@@ -139,6 +141,7 @@ export class JobView {
     for (const c of this.charts) c.schedule();
   }
 
+  /// Appends rows newer than the last one held; returns how many were new.
   add_rows(rows) {
     let last = this.rows.length ? this.rows[this.rows.length - 1].iteration : -Infinity;
     const body = $('rows').tBodies[0];
@@ -156,11 +159,12 @@ export class JobView {
       }
       body.append(tr);
     }
-    if (!fresh.length) return;
+    if (!fresh.length) return 0;
     const wrap = body.closest('.tablewrap');
     if (wrap.scrollHeight - wrap.scrollTop - wrap.clientHeight < 60) wrap.scrollTop = wrap.scrollHeight;
     this.draw_rows();
     this.render_head();
+    return fresh.length;
   }
 
   draw_rows() { for (const c of this.charts) c.set_rows(this.rows); }

@@ -6,7 +6,7 @@
 import * as THREE from 'three';
 import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
 import { triangle_edges, edge_lengths, classify, length_stats, histogram } from './edges.js';
-import { css, draw_histogram, fmt } from './charts.js';
+import { css, draw_histogram, fit_canvas, fmt } from './charts.js';
 
 const BINS = 64;
 
@@ -85,7 +85,14 @@ export class Viewer {
   forget(name) {
     const slot = this.slots.get(name);
     if (!slot) return;
-    if (this.current === slot) { this.scene.remove(slot.group); this.current = null; }
+    if (this.current === slot) {
+      this.scene.remove(slot.group);
+      this.current = null;
+      this.render();
+      fit_canvas(this.hist);  // clears it
+      this.caption.textContent = 'Edge lengths';
+      this.status.textContent = '';
+    }
     slot.geometry.dispose();
     slot.edge_geometry.dispose();
     this.slots.delete(name);
