@@ -178,6 +178,17 @@ async function submit(e) {
   e.preventDefault();
   params.clear_field_errors();
   const p = params.read_params();
+  if (!state.file && view.job) {
+    // Watching a job started elsewhere: run again on its (server-read) input, as GLB.
+    try {
+      const res = await api.request(api.result_url(view.job.id, 'input', 'glb'));
+      const stem = (view.job.input?.filename || 'input').replace(/\.[^.]*$/, '');
+      state.file = new File([await res.blob()], `${stem}.glb`, { type: 'model/gltf-binary' });
+    } catch (err) {
+      $('submit-status').textContent = `Cannot fetch the job's input: ${err.message}`;
+      return;
+    }
+  }
   if (!state.file) {
     $('submit-status').textContent = 'Choose a mesh file first.';
     $('file').focus();
@@ -193,6 +204,7 @@ async function submit(e) {
       $('submit-status').textContent = f < 1 ? `uploading ${Math.round(100 * f)} %` : 'reading on the server…';
     });
     $('submit-status').textContent = '';
+    state.file_job = job.id;
     location.hash = `job=${encodeURIComponent(job.id)}`;  // hashchange starts watching
   } catch (err) {
     $('submit-status').textContent = '';
@@ -268,6 +280,7 @@ function job_id_from_hash() {
 
 function watch(id) {
   state.watched = null;
+  if (id !== state.file_job) state.file = null;  // "Remesh" now re-runs this job's input
   for (const name of ['remeshed', 'dual']) state.viewer?.forget(name);
   set_available(['input']);
   $('show-input').checked = true;
