@@ -57,7 +57,7 @@ async function main() {
   const shot = (name) => page.screenshot({ path: path.join(artifacts, `${name}.png`), fullPage: true });
 
   await page.goto(base, { waitUntil: 'load' });
-  await page.waitForFunction(() => window.__remeshd, null, { timeout: 30000 });  // modules and three.js loaded
+  await page.waitForFunction(() => window.__remeshd, null, { timeout: 60000 });  // modules and three.js loaded
   await page.waitForSelector('#health.ok', { timeout: 10000 });
   check(true, 'page loads and /healthz answers');
 
@@ -147,7 +147,7 @@ async function main() {
 
   // --- a reload reconnects to the job and shows every row again ---
   await page.reload({ waitUntil: 'load' });
-  await page.waitForFunction(() => window.__remeshd, null, { timeout: 30000 });
+  await page.waitForFunction(() => window.__remeshd, null, { timeout: 60000 });
   await page.waitForFunction((n) => document.querySelectorAll('#rows tbody tr').length === n, rows.length, { timeout: 10000 })
     .catch(() => {});
   check(await page.$$eval('#rows tbody tr', (t) => t.length) === rows.length, 'after a reload the table holds every row again');
