@@ -63,7 +63,8 @@ TEST_CASE("Garbled files give an error or a valid mesh") {
         const std::size_t at = std::uniform_int_distribution<std::size_t>(0, n - 1)(rng);
         const unsigned v = rng();
         bad[at] = static_cast<char>(v % 2 ? interesting[(v >> 1) % sizeof interesting] : (v >> 8) & 0xff);
-        where += " " + std::to_string(at);
+        where += ' ';
+        where += std::to_string(at);
       }
       try_variant(bad, variant % 3 ? std::optional<Format>(file.format) : std::nullopt,
                   file.name + " with bytes changed at" + where, outcome);

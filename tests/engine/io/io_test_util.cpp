@@ -63,8 +63,12 @@ std::string write_ply_ascii(const PolygonSoup& soup) {
     out += buf;
   }
   for (std::size_t f = 0; f + 1 < soup.offsets.size(); ++f) {
-    out += "0 " + std::to_string(soup.offsets[f + 1] - soup.offsets[f]);
-    for (auto k = soup.offsets[f]; k < soup.offsets[f + 1]; ++k) out += " " + std::to_string(soup.indices[k]);
+    out += "0 ";  // (two appends: GCC 12 warns falsely about "literal" + std::string)
+    out += std::to_string(soup.offsets[f + 1] - soup.offsets[f]);
+    for (auto k = soup.offsets[f]; k < soup.offsets[f + 1]; ++k) {
+      out += ' ';
+      out += std::to_string(soup.indices[k]);
+    }
     out += " 1.5\n";
   }
   out += "3 65 66 67\n";
