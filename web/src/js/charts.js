@@ -93,8 +93,9 @@ export class IterationChart {
     if (this.percent) { lo = Math.max(0, Math.min(lo, 0)); hi = Math.max(hi, 100); }
     if (hi === lo) hi = lo + (Math.abs(lo) || 1);
     hi += (hi - lo) * 0.04;
-    const n_max = rows.length ? Math.max(rows[rows.length - 1].iteration, 1) : 1;
-    const n_min = rows.length ? Math.min(rows[0].iteration, n_max - 1) : 0;
+    const bars = this.series.some((s) => s.bars) ? 0.5 : 0;  // room for the first and last bar
+    const n_max = (rows.length ? Math.max(rows[rows.length - 1].iteration, 1) : 1) + bars;
+    const n_min = (rows.length ? Math.min(rows[0].iteration, n_max - 1) : 0) - bars;
     const x = (it) => pad.l + ((it - n_min) / (n_max - n_min || 1)) * pw;
     const y = (v) => pad.t + ph - ((v - lo) / (hi - lo)) * ph;
 
