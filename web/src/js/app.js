@@ -3,9 +3,9 @@
 
 import * as api from './api.js';
 import * as params from './params.js';
-import { read_preview, format_of } from './preview.js';
-import { parse_glb } from './glb.js';
-import { triangle_edges, edge_lengths, length_stats } from './edges.js';
+import { format_of } from './preview.js';
+import { length_stats } from './edges.js';
+import { in_worker } from './mesh_loader.js';
 import { JobView } from './job_view.js';
 import { JobsList } from './jobs_list.js';
 import { fmt } from './charts.js';
@@ -111,32 +111,6 @@ async function choose_file(file) {
   } catch (e) {
     status(`No local preview (${e.message}); the server reads it on upload.`);
   }
-}
-
-/// Reads {file} or parses {glb} and extracts the edges in mesh_worker.js; on the page's thread
-/// when workers are unavailable.
-function in_worker(message) {
-  return new Promise((resolve, reject) => {
-    let worker;
-    try {
-      worker = new Worker(new URL('./mesh_worker.js', import.meta.url), { type: 'module' });
-    } catch {
-      return resolve(on_this_thread(message));
-    }
-    worker.onmessage = ({ data }) => {
-      worker.terminate();
-      if (data.error) reject(new Error(data.error)); else resolve(data.mesh);
-    };
-    worker.onerror = (e) => { worker.terminate(); reject(new Error(e.message || 'mesh worker failed')); };
-    worker.postMessage(message);
-  });
-}
-
-async function on_this_thread(message) {
-  const mesh = message.file ? await read_preview(message.file) : parse_glb(message.glb);
-  const pairs = mesh.lines && mesh.lines.length ? mesh.lines
-    : triangle_edges(mesh.triangles, mesh.positions.length / 3);
-  return { ...mesh, pairs, lengths: edge_lengths(mesh.positions, pairs) };
 }
 
 function show_summary(s, source) {
