@@ -5,6 +5,28 @@
 ///
 /// Reading never touches the disk except for the one file named by read_mesh_file(); a .gltf whose
 /// buffers point to external files is refused (MeshError). All functions are thread-safe.
+///
+/// Validation and repair, in this order (element indices in messages are 0-based, in file order;
+/// text formats add " (line N)"):
+///   refused (MeshError): empty input; unknown format; malformed syntax ("OBJ line 12: bad vertex
+///     coordinate 'x'"); counts that do not fit the file ("OFF header claims ... but only N bytes
+///     follow"); a text file cut inside its last line; non-finite coordinates ("vertex 7 (line 9)
+///     has a non-finite coordinate (nan, 0, 1)"); faces with < 3 vertices ("face 4 (line 9) has 2
+///     vertices; a face needs at least 3"); indices out of range ("face 1 (line 6) refers to vertex
+///     8, but there are 4 vertices (0-based indices)"); edges with more than two faces
+///     ("non-manifold mesh: N edges are shared by more than 2 faces; the first joins vertices A and
+///     B (shared by k faces, e.g. face F (line L))"); non-orientable components ("non-orientable
+///     surface (e.g. a Moebius strip): ..."); no face left ("all N faces are degenerate or
+///     duplicates; no surface is left").
+///   repaired (Repair::kind, in this order): "polygons_triangulated" (ear clipping), "vertices_welded"
+///     (only with ReadOptions::weld), "degenerate_faces_removed" (repeated vertex or zero area:
+///     twice the area <= 1e-12 * longest edge^2), "duplicate_faces_removed" (same vertex set, any
+///     order; the first is kept), "faces_reoriented" (per connected component, the minority is
+///     flipped), "nonmanifold_vertices_split" (one copy per extra fan of a pinched vertex),
+///     "unreferenced_vertices_removed".
+///   STL corners are welded by exact position while reading (STL has no indices): not a repair.
+///   LimitError when ReadOptions::max_faces is exceeded (checked on header counts before
+///   allocating, and again after triangulation).
 
 #include <cstdint>
 #include <optional>
@@ -35,7 +57,8 @@ struct Repair {
 
 struct ReadOptions {
   std::optional<Format> format;  ///< from the caller (extension, Content-Type); else sniffed
-  bool weld = false;             ///< weld duplicate vertices at the same position
+  bool weld = false;             ///< weld vertices at exactly the same position (pinches this
+                                 ///< creates are split again like any pinched vertex)
   std::size_t max_faces = 0;     ///< refuse (LimitError) meshes with more faces; 0 = no limit
 };
 
