@@ -5,6 +5,7 @@
 #include <random>
 
 #include "remesh/geometry.h"
+#include "remesh/interval_cleanup.h"
 #include "remesh/low_pass_filter.h"
 #include "remesh/projection.h"
 #include "remesh/reference_surface.h"
@@ -265,4 +266,44 @@ TEST_CASE("projection lands on the reference surface", "[steps]") {
   const double moved = project_onto_reference(mesh, reference, 2);
   CHECK(moved > 0.05);
   for (auto v : mesh.vertices()) CHECK(std::abs(mesh.point(v).norm() - 1.0) < 2e-3);
+}
+
+TEST_CASE("the interval cleanup is safe, keeps vertices on the reference and is idempotent", "[steps]") {
+  const TriMesh sphere = test::make_icosphere(5, 20.0);  // fine reference, edge ~0.7
+  const ReferenceSurface reference(sphere);
+  TriMesh mesh = test::make_icosphere(3, 20.0);  // edge ~2.7: everything too long
+  // Bring it near the interval [1.2, 1.8] without cleanup: split every edge once, then project.
+  {
+    ComponentSizes sizes(mesh);
+    const std::size_t n = mesh.n_edges();
+    for (unsigned i = 0; i < n; ++i) split_edge(mesh, mesh.edge_handle(i), 1.5, sizes);
+    project_onto_reference(mesh, reference, 2);
+  }
+  auto outside = [](const TriMesh& m) {
+    std::size_t n = 0;
+    for (auto e : m.edges()) {
+      const double l = m.calc_edge_length(e);
+      n += (l < 1.2 || l > 1.8);
+    }
+    return n;
+  };
+  const std::size_t before = outside(mesh);
+  REQUIRE(before > 0);
+  const CleanupCounts counts = interval_cleanup(mesh, reference, 1.2, 1.8, 0.5);
+  CHECK(counts.outside_before == before);
+  CHECK(counts.outside_after == outside(mesh));
+  CHECK(outside(mesh) < before);
+  CHECK(test::check_mesh_valid(mesh) == "");
+  CHECK(test::euler_characteristic(mesh) == 2);
+  for (auto v : mesh.vertices()) CHECK(std::abs(mesh.point(v).norm() - 20.0) < 0.05);
+  // Run again: never worse; on a mesh with every edge inside it changes nothing.
+  const std::size_t after_first = outside(mesh);
+  interval_cleanup(mesh, reference, 1.2, 1.8, 0.5);
+  CHECK(outside(mesh) <= after_first);
+  TriMesh inside = test::make_icosphere(2, 1.0);
+  const TriMesh copy = inside;
+  const ReferenceSurface unit(inside);
+  const CleanupCounts none = interval_cleanup(inside, unit, 0.01, 100.0, 0.5);
+  CHECK(none.flips + none.collapses + none.splits + none.relocations == 0);
+  for (auto v : inside.vertices()) CHECK(inside.point(v) == copy.point(v));
 }
