@@ -208,8 +208,8 @@ TriMesh build_mesh(RawSoup raw, const ReadOptions& options, std::vector<Repair>&
   drop_bad_faces(soup, raw, repairs);
   if (soup.tris.empty())
     fail("all " + std::to_string(raw.face_count()) + " faces are degenerate or duplicates; no surface is left");
-  check_edges_and_orient(soup, raw, repairs);
-  split_pinched_vertices(soup, repairs);
+  const std::vector<EdgeUse> uses = check_edges_and_orient(soup, raw, repairs);
+  split_pinched_vertices(soup, uses, repairs);
   compact(soup, repairs);
   return assemble(soup);
 }

@@ -26,13 +26,21 @@ struct TriSoup {
 void triangulate_polygon(const std::vector<Vec3>& points, const std::int64_t* idx, std::size_t n,
                          std::vector<Tri>& out);
 
+/// One face's use of an undirected edge; sorted, equal (lo, hi) are adjacent.
+struct EdgeUse {
+  std::uint32_t lo, hi;  ///< vertex indices, lo < hi
+  std::uint32_t tri;
+  bool operator<(const EdgeUse& o) const { return lo != o.lo ? lo < o.lo : hi != o.hi ? hi < o.hi : tri < o.tri; }
+};
+
 /// Refuses edges with more than two faces (MeshError with count and first edge), then orients
 /// every component consistently (flipping the minority; MeshError for a non-orientable one).
-/// `where_face(f)` names input face f for messages. Appends a "faces_reoriented" repair if any.
-void check_edges_and_orient(TriSoup& soup, const RawSoup& raw, std::vector<Repair>& repairs);
+/// `raw` names input faces for messages. Appends a "faces_reoriented" repair if any. Returns
+/// the sorted edge uses (still valid after re-orientation, which keeps vertex sets).
+std::vector<EdgeUse> check_edges_and_orient(TriSoup& soup, const RawSoup& raw, std::vector<Repair>& repairs);
 
 /// Splits vertices whose faces form several fans (pinched vertices), one copy per extra fan.
-/// Precondition: check_edges_and_orient() passed. Appends "nonmanifold_vertices_split".
-void split_pinched_vertices(TriSoup& soup, std::vector<Repair>& repairs);
+/// `uses` comes from check_edges_and_orient(). Appends "nonmanifold_vertices_split".
+void split_pinched_vertices(TriSoup& soup, const std::vector<EdgeUse>& uses, std::vector<Repair>& repairs);
 
 }  // namespace remesh::io

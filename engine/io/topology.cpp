@@ -12,14 +12,10 @@ namespace remesh::io {
 
 namespace {
 
-struct EdgeUse {
-  std::uint32_t lo, hi;  ///< vertex indices, lo < hi
-  std::uint32_t tri;
-  std::uint8_t corner;  ///< the edge runs from corner to corner+1 (mod 3)
-  bool operator<(const EdgeUse& o) const {
-    return lo != o.lo ? lo < o.lo : hi != o.hi ? hi < o.hi : tri < o.tri;
-  }
-};
+/// True if the triangle runs its edge from a to b (rather than b to a).
+bool runs_forward(const Tri& t, std::uint32_t a, std::uint32_t b) {
+  return (t[0] == a && t[1] == b) || (t[1] == a && t[2] == b) || (t[2] == a && t[0] == b);
+}
 
 std::vector<EdgeUse> edge_uses(const TriSoup& soup) {
   std::vector<EdgeUse> uses;
@@ -27,7 +23,7 @@ std::vector<EdgeUse> edge_uses(const TriSoup& soup) {
   for (std::uint32_t t = 0; t < soup.tris.size(); ++t)
     for (std::uint8_t c = 0; c < 3; ++c) {
       std::uint32_t a = soup.tris[t][c], b = soup.tris[t][(c + 1) % 3];
-      uses.push_back({std::min(a, b), std::max(a, b), t, c});
+      uses.push_back({std::min(a, b), std::max(a, b), t});
     }
   std::sort(uses.begin(), uses.end());
   return uses;
@@ -64,8 +60,8 @@ std::string face_name(const TriSoup& soup, const RawSoup& raw, std::uint32_t t) 
 
 }  // namespace
 
-void check_edges_and_orient(TriSoup& soup, const RawSoup& raw, std::vector<Repair>& repairs) {
-  const std::vector<EdgeUse> uses = edge_uses(soup);
+std::vector<EdgeUse> check_edges_and_orient(TriSoup& soup, const RawSoup& raw, std::vector<Repair>& repairs) {
+  std::vector<EdgeUse> uses = edge_uses(soup);
   // Edges with more than two faces cannot be repaired without guessing: refuse.
   std::size_t bad = 0;
   std::string first;
@@ -90,7 +86,7 @@ void check_edges_and_orient(TriSoup& soup, const RawSoup& raw, std::vector<Repai
   std::vector<std::pair<std::uint32_t, std::uint32_t>> pairs;
   std::vector<bool> same;
   for_manifold_pairs(uses, [&](const EdgeUse& a, const EdgeUse& b) {
-    const bool same_dir = soup.tris[a.tri][a.corner] == soup.tris[b.tri][b.corner];
+    const bool same_dir = runs_forward(soup.tris[a.tri], a.lo, a.hi) == runs_forward(soup.tris[b.tri], b.lo, b.hi);
     pairs.push_back({a.tri, b.tri});
     same.push_back(same_dir);
   });
@@ -145,10 +141,10 @@ void check_edges_and_orient(TriSoup& soup, const RawSoup& raw, std::vector<Repai
     repairs.push_back({"faces_reoriented", flipped,
                        std::to_string(flipped) + " faces flipped to agree with their neighbours in " +
                            std::to_string(components_flipped) + " component(s)"});
+  return uses;
 }
 
-void split_pinched_vertices(TriSoup& soup, std::vector<Repair>& repairs) {
-  const std::vector<EdgeUse> uses = edge_uses(soup);
+void split_pinched_vertices(TriSoup& soup, const std::vector<EdgeUse>& uses, std::vector<Repair>& repairs) {
   const std::size_t n = soup.tris.size();
   // Corners around a vertex are one fan when consecutive faces share an edge at that vertex.
   UnionFind fans(3 * n);
