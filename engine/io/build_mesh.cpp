@@ -83,16 +83,37 @@ void weld(TriSoup& soup, std::vector<Repair>& repairs) {
   std::unordered_map<Vec3, std::uint32_t, Hash> first;
   first.reserve(soup.points.size());
   std::vector<std::uint32_t> map(soup.points.size());
+  for (std::uint32_t i = 0; i < soup.points.size(); ++i) map[i] = first.try_emplace(soup.points[i], i).first->second;
+  const std::vector<Tri> original = soup.tris;
+  auto apply = [&] {
+    for (std::size_t t = 0; t < original.size(); ++t)
+      for (int c = 0; c < 3; ++c) soup.tris[t][c] = map[original[t][c]];
+  };
+  // Weld only where the surface stays manifold: a welded vertex on an edge that would then have
+  // more than two faces is unwelded again (with its whole group), a few rounds at most.
+  for (int round = 0; round < 8; ++round) {
+    apply();
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> edges;
+    edges.reserve(3 * soup.tris.size());
+    for (const Tri& t : soup.tris) {
+      if (t[0] == t[1] || t[1] == t[2] || t[0] == t[2]) continue;
+      for (int c = 0; c < 3; ++c) edges.push_back(std::minmax(t[c], t[(c + 1) % 3]));
+    }
+    std::sort(edges.begin(), edges.end());
+    std::vector<bool> crowded(soup.points.size(), false);
+    for (std::size_t i = 0; i + 2 < edges.size(); ++i)
+      if (edges[i] == edges[i + 2]) crowded[edges[i].first] = crowded[edges[i].second] = true;
+    bool changed = false;
+    for (std::uint32_t i = 0; i < map.size(); ++i)
+      if (map[i] != i && crowded[map[i]]) map[i] = i, changed = true;
+    if (!changed) break;
+  }
+  apply();
   std::size_t welded = 0;
   soup.welded_away.assign(soup.points.size(), false);
-  for (std::uint32_t i = 0; i < soup.points.size(); ++i) {
-    auto [it, inserted] = first.try_emplace(soup.points[i], i);
-    map[i] = it->second;
-    if (!inserted) ++welded, soup.welded_away[i] = true;
-  }
+  for (std::uint32_t i = 0; i < map.size(); ++i)
+    if (map[i] != i) ++welded, soup.welded_away[i] = true;
   if (welded == 0) return;
-  for (Tri& t : soup.tris)
-    for (auto& v : t) v = map[v];
   repairs.push_back({"vertices_welded", welded,
                      std::to_string(welded) + " duplicate vertices at identical positions welded"});
 }

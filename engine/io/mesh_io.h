@@ -19,7 +19,7 @@
 ///     surface (e.g. a Moebius strip): ..."); no face left ("all N faces are degenerate or
 ///     duplicates; no surface is left").
 ///   repaired (Repair::kind, in this order): "polygons_triangulated" (ear clipping), "vertices_welded"
-///     (only with ReadOptions::weld), "degenerate_faces_removed" (repeated vertex or zero area:
+///     (only with ReadOptions::weld; never creates a non-manifold edge), "degenerate_faces_removed" (repeated vertex or zero area:
 ///     twice the area <= 1e-12 * longest edge^2), "duplicate_faces_removed" (same vertex set, any
 ///     order; the first is kept), "faces_reoriented" (per connected component, the minority is
 ///     flipped), "nonmanifold_vertices_split" (one copy per extra fan of a pinched vertex),
@@ -57,8 +57,8 @@ struct Repair {
 
 struct ReadOptions {
   std::optional<Format> format;  ///< from the caller (extension, Content-Type); else sniffed
-  bool weld = false;             ///< weld vertices at exactly the same position (pinches this
-                                 ///< creates are split again like any pinched vertex)
+  bool weld = false;             ///< weld vertices at exactly the same position, except where an
+                                 ///< edge would get more than 2 faces (pinches it makes are split)
   std::size_t max_faces = 0;     ///< refuse (LimitError) meshes with more faces; 0 = no limit
 };
 

@@ -248,3 +248,24 @@ TEST_CASE("Text files cut inside their last line are refused as truncated") {
                          "endloop\nendfacet\n"),
                     Contains("endsolid"));
 }
+
+TEST_CASE("Welding stops where it would make an edge non-manifold") {
+  // Three separate triangles whose spine edges coincide (a book with three pages), plus a square
+  // split along a seam of duplicated vertices: only the seam is welded.
+  const std::string obj =
+      "v 0 0 0\nv 0 0 1\nv 1 0 0\n"
+      "v 0 0 0\nv 0 0 1\nv 0 1 0\n"
+      "v 0 0 0\nv 0 0 1\nv -1 -1 0\n"
+      "v 5 0 0\nv 6 0 0\nv 6 1 0\nv 5 0 0\nv 6 1 0\nv 5 1 0\n"
+      "f 1 2 3\nf 4 5 6\nf 7 8 9\nf 10 11 12\nf 13 14 15\n";
+  ReadOptions weld;
+  weld.weld = true;
+  LoadedMesh m = read(obj, weld);
+  const Repair* r = find_repair(m, "vertices_welded");
+  REQUIRE(r);
+  CHECK(r->count == 2);  // the seam's two duplicates; the book's spine stays apart
+  MeshSummary s = summarize(m.mesh);
+  CHECK(s.components == 4);
+  CHECK(m.mesh.n_faces() == 5);
+  CHECK(test::check_loaded(m.mesh).empty());
+}
