@@ -18,11 +18,12 @@
 ///     B (shared by k faces, e.g. face F (line L))"); non-orientable components ("non-orientable
 ///     surface (e.g. a Moebius strip): ..."); no face left ("all N faces are degenerate or
 ///     duplicates; no surface is left").
-///   repaired (Repair::kind, in this order): "polygons_triangulated" (ear clipping), "vertices_welded"
-///     (only with ReadOptions::weld; never creates a non-manifold edge), "degenerate_faces_removed" (repeated vertex or zero area:
-///     twice the area <= 1e-12 * longest edge^2), "duplicate_faces_removed" (same vertex set, any
-///     order; the first is kept), "faces_reoriented" (per connected component, the minority is
-///     flipped), "nonmanifold_vertices_split" (one copy per extra fan of a pinched vertex),
+///   repaired (Repair::kind, in this order): "polygons_triangulated" (ear clipping);
+///     "vertices_welded" (only with ReadOptions::weld, never creating a non-manifold edge);
+///     "degenerate_faces_removed" (repeated vertex or zero area: twice the area <= 1e-12 *
+///     longest edge^2); "duplicate_faces_removed" (same vertex set in any order, the first kept);
+///     "faces_reoriented" (per connected component, the minority is flipped);
+///     "nonmanifold_vertices_split" (one copy per extra fan of a pinched vertex);
 ///     "unreferenced_vertices_removed".
 ///   STL corners are welded by exact position while reading (STL has no indices): not a repair.
 ///   LimitError when ReadOptions::max_faces is exceeded (checked on header counts before
