@@ -163,6 +163,7 @@ ParsedParams parse_with(Has has, Parse parse) {
       if (spec.required) out.errors.push_back({spec.name, "is required"});
       continue;
     }
+    out.given.emplace_back(spec.name);
     Value v;
     if (parse(spec.name, spec.kind, v)) store(out, spec.name, v);
     else out.errors.push_back({spec.name, kind_message(spec.kind)});

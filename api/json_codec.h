@@ -49,6 +49,7 @@ struct ParsedParams {
   Params params;                   ///< defaults where a field was absent or bad
   bool weld = false;               ///< read option: weld duplicate vertices
   std::vector<FieldError> errors;  ///< empty when every field parsed (range checks: check())
+  std::vector<std::string> given;  ///< names of the parameters present in the input
   bool ok() const { return errors.empty(); }
 };
 
@@ -67,7 +68,8 @@ ParsedParams params_from_query(const std::map<std::string, std::string>& values,
                                const std::vector<std::string>& ignore = {});
 
 /// Parsing errors plus the engine's range checks (remesh::check) for fields that parsed, and
-/// `iterations` against `max_iterations` (the service's limit, 0 = engine default). Defined in
+/// `iterations` against `max_iterations` (the service's limit, 0 = engine default). When
+/// `iterations` was not given, the default is lowered to `max_iterations` if above it. Defined in
 /// params_validation.cpp (links the remesher library).
 std::vector<FieldError> validate_params(ParsedParams& parsed, int max_iterations = 0);
 

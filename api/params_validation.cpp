@@ -1,3 +1,4 @@
+#include <algorithm>
 #include <set>
 
 #include "json_codec.h"
@@ -8,7 +9,11 @@ std::vector<FieldError> validate_params(ParsedParams& parsed, int max_iterations
   std::vector<FieldError> errors = parsed.errors;
   std::set<std::string> bad;
   for (const FieldError& e : errors) bad.insert(e.field);
-  if (max_iterations > 0) parsed.params.max_iterations = max_iterations;
+  if (max_iterations > 0) {
+    parsed.params.max_iterations = max_iterations;
+    bool given = std::find(parsed.given.begin(), parsed.given.end(), "iterations") != parsed.given.end();
+    if (!given) parsed.params.iterations = std::min(parsed.params.iterations, max_iterations);
+  }
   // Only range-check what parsed; a field already reported is not reported twice.
   if (!bad.count("emin") && !bad.count("emax")) {
     for (const FieldError& e : check(parsed.params))

@@ -333,7 +333,9 @@ void HttpServer::Impl::post_job(const httplib::Request& req, httplib::Response& 
   if (req.is_multipart_form_data() && !got_mesh) errors.push_back({"mesh", "is required (a file field named 'mesh')"});
   else if (body.empty()) errors.push_back({"mesh", "is empty"});
   auto format = remesh::api::resolve_format(req.get_param_value("format"), filename, part_type, errors);
-  for (const FieldError& e : remesh::validate_params(parsed, options.max_iterations)) errors.push_back(e);
+  bool params_readable = errors.empty() || errors.front().field != "params";
+  if (params_readable)
+    for (const FieldError& e : remesh::validate_params(parsed, options.max_iterations)) errors.push_back(e);
   if (!errors.empty()) {
     send_problem(res, 422, "invalid request: see errors", errors);
     return;

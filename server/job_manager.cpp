@@ -389,10 +389,14 @@ void JobManager::expire() {
       if (config_.job_ttl_seconds > 0 && *r.finished_at + config_.job_ttl_seconds < now) expired.push_back(id);
       else finished.emplace_back(*r.finished_at, id);
     }
-    for (const std::string& id : expired) jobs_.erase(id);
   }
+  // Files first, then the entry: once a job reads as gone, its directory is gone too.
   for (const std::string& id : expired) {
     store_.remove(id);
+    {
+      std::lock_guard lock(mutex_);
+      jobs_.erase(id);
+    }
     log_.info("job", {str("job", id), str("removed", "expired")});
   }
   if (config_.data_cap_bytes == 0) return;
@@ -407,11 +411,11 @@ void JobManager::expire() {
   std::sort(finished.begin(), finished.end());
   for (const auto& [when, id] : finished) {
     if (total <= config_.data_cap_bytes) break;
+    store_.remove(id);
     {
       std::lock_guard lock(mutex_);
       jobs_.erase(id);
     }
-    store_.remove(id);
     total -= std::min(total, sizes[id]);
     log_.info("job", {str("job", id), str("removed", "data cap")});
   }

@@ -1,0 +1,282 @@
+// Cancellation, the queue bound, authentication, CORS, upload limits, static files, expiry and
+// restarts (SIGKILL and SIGTERM) of the real daemon.
+#include <catch2/catch.hpp>
+
+#include <signal.h>
+
+#include <fstream>
+#include <thread>
+
+#include "daemon.h"
+
+using nlohmann::json;
+using namespace remesh::test;
+
+namespace {
+
+std::string submit(httplib::Client& c, const std::string& mesh, const std::string& query) {
+  auto r = submit_raw(c, mesh, query);
+  REQUIRE(r);
+  INFO(r->body);
+  REQUIRE(r->status == 202);
+  return json::parse(r->body)["id"];
+}
+
+/// A job that runs long enough to be caught running (stopped by the tests).
+const char* kLong = "emin=0.02&emax=0.035&iterations=400&run_all_iterations=true";
+/// A job of a few quick iterations.
+const char* kShort = "emin=0.08&emax=0.12&iterations=5&run_all_iterations=true";
+
+bool running_with_rows(const json& j) { return j["state"] == "running" && j["progress"]["iteration"] >= 1; }
+
+}  // namespace
+
+TEST_CASE("remeshd: cancel queued and running jobs; the queue bound", "[server][cancel]") {
+  TempDir tmp;
+  Daemon d(tmp.path / "data", {"--workers", "1", "--queue-size", "1"});
+  auto c = d.client();
+  const std::string running = submit(c, sphere_obj(4), kLong);
+  wait_job(c, running, running_with_rows);
+  const std::string queued = submit(c, sphere_obj(2), kShort);
+  CHECK(get_job(c, queued)["state"] == "queued");
+
+  // Queue full: 503 with Retry-After, nothing stored.
+  std::size_t files = count_files(tmp.path / "data");
+  auto full = submit_raw(c, sphere_obj(2), kShort);
+  REQUIRE(full);
+  CHECK(full->status == 503);
+  CHECK_FALSE(full->get_header_value("Retry-After").empty());
+  CHECK(count_files(tmp.path / "data") == files);
+
+  // Cancel the queued job: cancelled at once.
+  auto cq = c.Delete(("/api/v1/jobs/" + queued).c_str());
+  REQUIRE(cq);
+  CHECK(cq->status == 202);
+  CHECK(json::parse(cq->body)["state"] == "cancelled");
+  CHECK(get_job(c, queued)["outcome"] == "cancelled");
+
+  // Cancel the running job: cancelling, then cancelled within an iteration or so.
+  int before = get_job(c, running)["progress"]["iteration"];
+  auto cr = c.Delete(("/api/v1/jobs/" + running).c_str());
+  REQUIRE(cr);
+  CHECK(cr->status == 202);
+  std::string st = json::parse(cr->body)["state"];
+  CHECK((st == "cancelling" || st == "cancelled"));
+  json after = wait_final(c, running, 30);
+  CHECK(after["state"] == "cancelled");
+  CHECK(after["outcome"] == "cancelled");
+  CHECK(after["progress"]["iteration"].get<int>() <= before + 2);
+  CHECK(after["progress"]["iteration"].get<int>() < 400);
+  // The worker lives on: the next job runs.
+  const std::string next = submit(c, sphere_obj(2), kShort);
+  CHECK(wait_final(c, next)["state"] == "succeeded");
+  // A finished (cancelled) job is removed by DELETE.
+  CHECK(c.Delete(("/api/v1/jobs/" + running).c_str())->status == 204);
+}
+
+TEST_CASE("remeshd: bearer token on /api routes only; CORS", "[server][auth]") {
+  TempDir tmp;
+  TempDir web;
+  { std::ofstream(web.path / "index.html") << "<!doctype html><title>page</title>"; }
+  Daemon d(tmp.path / "data", {"--token", "s3cret", "--cors-origin", "http://example.test", "--web-root",
+                               web.path.string()});
+  auto anon = d.client();
+  auto r = anon.Get("/api/v1/jobs");
+  REQUIRE(r);
+  CHECK(r->status == 401);
+  CHECK(r->get_header_value("Content-Type") == "application/problem+json");
+  CHECK(r->get_header_value("WWW-Authenticate").rfind("Bearer", 0) == 0);
+  CHECK(anon.Post("/api/v1/jobs?emin=1&emax=2", sphere_obj(1), "model/obj")->status == 401);
+  CHECK(anon.Get("/api/v1/openapi.yaml")->status == 401);
+  CHECK(d.client("wrong").Get("/api/v1/jobs")->status == 401);
+  CHECK(anon.Get("/healthz")->status == 200);
+  CHECK(anon.Get("/metrics")->status == 200);
+  auto page = anon.Get("/");
+  REQUIRE(page);
+  CHECK(page->status == 200);
+  CHECK(page->body.find("page") != std::string::npos);
+
+  auto authed = d.client("s3cret");
+  auto ok = authed.Get("/api/v1/jobs");
+  REQUIRE(ok);
+  CHECK(ok->status == 200);
+  CHECK(ok->get_header_value("Access-Control-Allow-Origin") == "http://example.test");
+  CHECK(anon.Get("/api/v1/jobs?access_token=s3cret")->status == 200);  // EventSource, links
+  const std::string id = submit(authed, sphere_obj(2), kShort);
+  CHECK(wait_final(authed, id)["state"] == "succeeded");
+  CHECK(anon.Get(("/api/v1/jobs/" + id + "/events").c_str())->status == 401);
+
+  // Preflight.
+  auto pre = anon.Options("/api/v1/jobs", {{"Origin", "http://example.test"}, {"Access-Control-Request-Method", "POST"}});
+  REQUIRE(pre);
+  CHECK(pre->status == 204);
+  CHECK(pre->get_header_value("Access-Control-Allow-Origin") == "http://example.test");
+  CHECK(pre->get_header_value("Access-Control-Allow-Headers").find("Authorization") != std::string::npos);
+
+  // Without the options: no token needed, no CORS headers.
+  TempDir tmp2;
+  Daemon open(tmp2.path / "data");
+  auto o = open.client().Get("/api/v1/jobs");
+  REQUIRE(o);
+  CHECK(o->status == 200);
+  CHECK_FALSE(o->has_header("Access-Control-Allow-Origin"));
+}
+
+TEST_CASE("remeshd: upload limits are enforced while reading", "[server][limits]") {
+  TempDir tmp;
+  Daemon d(tmp.path / "data", {"--max-upload-mb", "1"});
+  auto c = d.client();
+  const std::string mesh = sphere_obj(2);
+  std::string big = mesh;
+  while (big.size() < 3 * 1024 * 1024) big += "# padding comment line to grow the upload past the limit\n";
+
+  // Chunked (no Content-Length): counted while reading, refused, nothing stored.
+  std::size_t sent = 0;
+  auto chunked = c.Post(
+      "/api/v1/jobs?emin=0.2&emax=0.35",
+      [&](size_t, httplib::DataSink& sink) {
+        std::size_t n = std::min<std::size_t>(64 * 1024, big.size() - sent);
+        if (n == 0) {
+          sink.done();
+          return true;
+        }
+        sink.write(big.data() + sent, n);
+        sent += n;
+        return true;
+      },
+      "model/obj");
+  REQUIRE(chunked);
+  CHECK(chunked->status == 413);
+  CHECK(chunked->get_header_value("Content-Type") == "application/problem+json");
+  CHECK(count_files(tmp.path / "data" / "jobs") == 0);
+
+  // With Content-Length over the limit.
+  auto plain = c.Post("/api/v1/jobs?emin=0.2&emax=0.35", big, "model/obj");
+  REQUIRE(plain);
+  CHECK(plain->status == 413);
+  // Multipart over the limit.
+  httplib::MultipartFormDataItems items = {{"mesh", big, "big.obj", ""}};
+  auto multi = c.Post("/api/v1/jobs", items);
+  REQUIRE(multi);
+  CHECK(multi->status == 413);
+  CHECK(count_files(tmp.path / "data" / "jobs") == 0);
+
+  // The server is fine afterwards, and an upload under the limit passes.
+  auto ok = submit_raw(c, mesh, "emin=0.2&emax=0.35&iterations=2");
+  REQUIRE(ok);
+  CHECK(ok->status == 202);
+}
+
+TEST_CASE("remeshd: static files from the web root, safely", "[server][static]") {
+  TempDir tmp;
+  TempDir web;
+  std::filesystem::create_directories(web.path / "js");
+  { std::ofstream(web.path / "index.html") << "<!doctype html><p>hello"; }
+  { std::ofstream(web.path / "js" / "app.mjs") << "export const x = 1;"; }
+  { std::ofstream(web.path / "style.css") << "body{}"; }
+  { std::ofstream(web.path / "icon.svg") << "<svg/>"; }
+  { std::ofstream(tmp.path / "secret.txt") << "TOP-SECRET-CONTENT"; }
+  Daemon d(tmp.path / "data", {"--web-root", web.path.string()});
+  auto c = d.client();
+  struct Row {
+    const char* path;
+    int status;
+    const char* type;
+  };
+  const Row rows[] = {
+      {"/", 200, "text/html"},
+      {"/index.html", 200, "text/html"},
+      {"/js/app.mjs", 200, "text/javascript"},
+      {"/style.css", 200, "text/css"},
+      {"/icon.svg", 200, "image/svg+xml"},
+      {"/missing.js", 404, "application/problem+json"},
+      {"/../secret.txt", 404, nullptr},
+      {"/%2e%2e/secret.txt", 404, nullptr},
+      {"/js/../../secret.txt", 404, nullptr},
+  };
+  for (const Row& row : rows) {
+    INFO(row.path);
+    auto r = c.Get(row.path);
+    REQUIRE(r);
+    CHECK(r->status == row.status);
+    if (row.type) CHECK(r->get_header_value("Content-Type").rfind(row.type, 0) == 0);
+    CHECK(r->body.find("TOP-SECRET-CONTENT") == std::string::npos);
+  }
+  // A missing web root: / explains, nothing else breaks.
+  TempDir tmp2;
+  Daemon bare(tmp2.path / "data", {"--web-root", (tmp2.path / "nowhere").string()});
+  auto r = bare.client().Get("/");
+  REQUIRE(r);
+  CHECK(r->status == 200);
+  CHECK(r->body.find("not installed") != std::string::npos);
+}
+
+TEST_CASE("remeshd: restart after SIGKILL keeps finished jobs and completes the interrupted one",
+          "[server][restart]") {
+  TempDir tmp;
+  const auto data = tmp.path / "data";
+  std::string finished, interrupted, etag, obj;
+  int expected_iterations = 0;
+  {
+    Daemon d(data, {"--workers", "1"});
+    auto c = d.client();
+    finished = submit(c, sphere_obj(2), kShort);
+    REQUIRE(wait_final(c, finished)["state"] == "succeeded");
+    auto f = c.Get(("/api/v1/jobs/" + finished + "/result?mesh=remeshed&format=obj").c_str());
+    REQUIRE(f);
+    etag = f->get_header_value("ETag");
+    obj = f->body;
+    // Long enough to be killed mid-run, short enough to finish after the restart.
+    interrupted = submit(c, sphere_obj(4), "emin=0.05&emax=0.08&iterations=12&run_all_iterations=true");
+    wait_job(c, interrupted, running_with_rows);
+    expected_iterations = 12;
+    CHECK(d.stop(SIGKILL) == 128 + SIGKILL);
+  }
+  Daemon again(data, {"--workers", "1"});
+  auto c = again.client();
+  json list = json::parse(c.Get("/api/v1/jobs")->body);
+  CHECK(list["total"] == 2);
+  json f = get_job(c, finished);
+  CHECK(f["state"] == "succeeded");
+  auto file = c.Get(("/api/v1/jobs/" + finished + "/result?mesh=remeshed&format=obj").c_str());
+  REQUIRE(file);
+  CHECK(file->status == 200);
+  CHECK(file->get_header_value("ETag") == etag);
+  CHECK(file->body == obj);
+  auto events = read_events(again.port(), "/api/v1/jobs/" + finished + "/events");
+  CHECK(events.events.back().event == "end");
+
+  json done = wait_final(c, interrupted, 90);
+  CHECK(done["state"] == "succeeded");
+  CHECK(done["progress"]["iteration"] == expected_iterations);
+  auto rows = json::parse(c.Get(("/api/v1/jobs/" + interrupted + "/stats").c_str())->body)["rows"];
+  CHECK(rows.size() == static_cast<std::size_t>(expected_iterations));
+  CHECK(rows[0]["iteration"] == 1);
+  CHECK(c.Get(("/api/v1/jobs/" + interrupted + "/result?mesh=dual&format=glb").c_str())->status == 200);
+}
+
+TEST_CASE("remeshd: SIGTERM interrupts running jobs without losing them; expiry", "[server][restart]") {
+  TempDir tmp;
+  const auto data = tmp.path / "data";
+  std::string id;
+  {
+    Daemon d(data, {"--workers", "1"});
+    auto c = d.client();
+    id = submit(c, sphere_obj(4), "emin=0.05&emax=0.08&iterations=10&run_all_iterations=true");
+    wait_job(c, id, running_with_rows);
+    CHECK(d.stop(SIGTERM) == 0);
+  }
+  {
+    // A TTL of ~2 s: the job runs again to the end, then expires.
+    Daemon again(data, {"--workers", "1", "--job-ttl-hours", "0.0005"});
+    auto c = again.client();
+    CHECK(wait_final(c, id, 90)["state"] == "succeeded");
+    bool gone = false;
+    for (int i = 0; i < 300 && !gone; ++i) {
+      gone = c.Get(("/api/v1/jobs/" + id).c_str())->status == 404;
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+    CHECK(gone);
+    CHECK_FALSE(std::filesystem::exists(data / "jobs" / id));
+  }
+}

@@ -1,0 +1,312 @@
+// Every route and every error status of the public API, against the real daemon.
+#include <catch2/catch.hpp>
+
+#include <fstream>
+#include <regex>
+#include <set>
+
+#include "daemon.h"
+#include "routes.h"
+
+using nlohmann::json;
+using namespace remesh::test;
+
+namespace {
+
+json body_of(const httplib::Result& r) { return json::parse(r->body); }
+
+std::string submit_ok(httplib::Client& c, const std::string& mesh, const std::string& query) {
+  auto r = submit_raw(c, mesh, query);
+  REQUIRE(r);
+  INFO(r->body);
+  REQUIRE(r->status == 202);
+  return body_of(r)["id"];
+}
+
+std::set<std::string> error_fields(const httplib::Result& r) {
+  std::set<std::string> s;
+  json body = body_of(r);
+  for (const auto& e : body["errors"]) s.insert(e["field"].get<std::string>());
+  return s;
+}
+
+}  // namespace
+
+TEST_CASE("remeshd: submit raw and multipart, follow, download, list, delete", "[server]") {
+  TempDir tmp;
+  Daemon d(tmp.path / "data", {"--workers", "2"});
+  auto c = d.client();
+  const std::string mesh = sphere_obj(2);
+
+  // Raw body, format from Content-Type.
+  auto r = submit_raw(c, mesh, "emin=0.2&emax=0.35&iterations=4&filename=ball.obj");
+  REQUIRE(r);
+  INFO(r->body);
+  REQUIRE(r->status == 202);
+  json job = body_of(r);
+  const std::string id = job["id"];
+  CHECK(std::regex_match(id, std::regex("[0-9a-f]{32}")));
+  CHECK(r->get_header_value("Location") == "/api/v1/jobs/" + id);
+  CHECK(job["input"]["format"] == "obj");
+  CHECK(job["input"]["filename"] == "ball.obj");
+  CHECK(job["input"]["bytes"] == mesh.size());
+  CHECK(job["input"]["summary"]["faces"] == 320);
+  CHECK(job["input"]["summary"]["genus"] == json::array({0}));
+  CHECK(job["params"]["emin"] == 0.2);
+  CHECK(job["progress"]["iterations"] == 4);
+  CHECK_FALSE(job["links"].contains("results"));
+
+  // The validated input is downloadable at once, in every state.
+  auto input = c.Get(job["links"]["input"].get<std::string>().c_str());
+  REQUIRE(input);
+  CHECK(input->status == 200);
+  CHECK(input->get_header_value("Content-Type") == "model/gltf-binary");
+  CHECK(input->body.substr(0, 4) == "glTF");
+
+  // Multipart: file name gives the format (the sniffing would also find it), params as JSON.
+  httplib::MultipartFormDataItems items = {
+      {"mesh", mesh, "ball2.obj", "application/octet-stream"},
+      {"params", R"({"emin":0.2,"emax":0.35,"iterations":3,"weld":true})", "", "application/json"}};
+  auto m = c.Post("/api/v1/jobs", items);
+  REQUIRE(m);
+  INFO(m->body);
+  REQUIRE(m->status == 202);
+  const std::string id2 = body_of(m)["id"];
+  CHECK(body_of(m)["params"]["weld"] == true);
+  CHECK(body_of(m)["input"]["filename"] == "ball2.obj");
+
+  // Raw with octet-stream: sniffed.
+  auto s = submit_raw(c, mesh, "emin=0.2&emax=0.35&iterations=2", "application/octet-stream");
+  REQUIRE(s);
+  CHECK(s->status == 202);
+  const std::string id3 = body_of(s)["id"];
+
+  json done = wait_final(c, id);
+  REQUIRE(done["state"] == "succeeded");
+  CHECK((done["outcome"] == "converged" || done["outcome"] == "completed"));
+  CHECK(done["progress"]["iteration"].get<int>() >= 1);
+  CHECK(done["latest"]["iteration"] == done["progress"]["iteration"]);
+  CHECK(done["finished_at"].is_string());
+  CHECK(done["timings"]["run_seconds"].get<double>() >= 0);
+  REQUIRE(done["links"].contains("results"));
+  for (const auto& [kind, formats] : done["links"]["results"].items())
+    for (const auto& [fmt, url] : formats.items()) {
+      auto f = c.Get(url.get<std::string>().c_str());
+      REQUIRE(f);
+      INFO(url);
+      CHECK(f->status == 200);
+      CHECK_FALSE(f->body.empty());
+      CHECK(f->get_header_value("Content-Disposition") ==
+            "attachment; filename=\"ball-" + kind + "." + fmt + "\"");
+      // ETag and If-None-Match.
+      std::string etag = f->get_header_value("ETag");
+      REQUIRE_FALSE(etag.empty());
+      auto again = c.Get(url.get<std::string>().c_str(), {{"If-None-Match", etag}});
+      REQUIRE(again);
+      CHECK(again->status == 304);
+    }
+  auto obj = c.Get(("/api/v1/jobs/" + id + "/result?mesh=remeshed&format=obj").c_str());
+  REQUIRE(obj);
+  CHECK(obj->body.find("\nf ") != std::string::npos);
+  auto glb = c.Get(("/api/v1/jobs/" + id + "/result?mesh=dual&format=glb").c_str());
+  REQUIRE(glb);
+  CHECK(glb->body.substr(0, 4) == "glTF");
+
+  // Stats as JSON and CSV agree with the document.
+  auto stats = c.Get(("/api/v1/jobs/" + id + "/stats").c_str());
+  REQUIRE(stats);
+  json rows = body_of(stats)["rows"];
+  REQUIRE(rows.size() == done["progress"]["iteration"].get<std::size_t>());
+  CHECK(rows.back() == done["latest"]);
+  auto csv = c.Get(("/api/v1/jobs/" + id + "/stats?format=csv").c_str());
+  REQUIRE(csv);
+  CHECK(csv->get_header_value("Content-Type").rfind("text/csv", 0) == 0);
+  CHECK(csv->body.rfind("iteration,vertices,edges,mean,", 0) == 0);
+  CHECK(std::count(csv->body.begin(), csv->body.end(), '\n') == static_cast<long>(rows.size() + 1));
+
+  // List: newest first, filters, pagination.
+  wait_final(c, id2);
+  wait_final(c, id3);
+  auto list = c.Get("/api/v1/jobs");
+  REQUIRE(list);
+  json l = body_of(list);
+  CHECK(l["total"] == 3);
+  REQUIRE(l["jobs"].size() == 3);
+  CHECK(l["jobs"][0]["id"] == id3);
+  CHECK(l["jobs"][2]["id"] == id);
+  json page = body_of(c.Get("/api/v1/jobs?limit=1&offset=1"));
+  CHECK(page["jobs"].size() == 1);
+  CHECK(page["jobs"][0]["id"] == id2);
+  CHECK(page["total"] == 3);
+  CHECK(body_of(c.Get("/api/v1/jobs?state=running"))["total"] == 0);
+  CHECK(body_of(c.Get("/api/v1/jobs?state=succeeded"))["total"] == 3);
+
+  // Delete a finished job: 204, files gone, then 404.
+  auto del = c.Delete(("/api/v1/jobs/" + id).c_str());
+  REQUIRE(del);
+  CHECK(del->status == 204);
+  CHECK_FALSE(std::filesystem::exists(tmp.path / "data" / "jobs" / id));
+  CHECK(c.Get(("/api/v1/jobs/" + id).c_str())->status == 404);
+  CHECK(c.Delete(("/api/v1/jobs/" + id).c_str())->status == 404);
+
+  // Health and metrics.
+  auto h = c.Get("/healthz");
+  REQUIRE(h);
+  CHECK(body_of(h)["status"] == "ok");
+  auto metrics = c.Get("/metrics");
+  REQUIRE(metrics);
+  CHECK(metrics->body.find("remeshd_jobs{state=\"succeeded\"} 2") != std::string::npos);
+  CHECK(metrics->body.find("remeshd_queue_depth 0") != std::string::npos);
+  CHECK(metrics->body.find("remeshd_busy_workers") != std::string::npos);
+  CHECK(metrics->body.find("remeshd_iterations_total") != std::string::npos);
+  CHECK(metrics->body.find("remeshd_iterations_per_second") != std::string::npos);
+  CHECK(metrics->body.find("remeshd_http_requests_total{method=\"POST\",route=\"/api/v1/jobs\",status=\"202\"} 3") !=
+        std::string::npos);
+  CHECK(metrics->body.find("remeshd_http_request_duration_seconds_bucket{route=\"/api/v1/jobs/{id}/result\"") !=
+        std::string::npos);
+}
+
+TEST_CASE("remeshd: the errors each route must give", "[server]") {
+  TempDir tmp;
+  Daemon d(tmp.path / "data", {"--workers", "1", "--max-iterations", "50", "--max-faces", "2000",
+                               "--max-output-faces", "50000"});
+  auto c = d.client();
+  const std::string mesh = sphere_obj(2);
+
+  struct Row {
+    std::string query;
+    std::string body;
+    std::string content_type;
+    int status;
+    std::set<std::string> fields;
+  };
+  const std::vector<Row> rows = {
+      {"emax=0.3", mesh, "model/obj", 422, {"emin"}},
+      {"", mesh, "model/obj", 422, {"emin", "emax"}},
+      {"emin=abc&emax=0.3", mesh, "model/obj", 422, {"emin"}},
+      {"emin=0.4&emax=0.3", mesh, "model/obj", 422, {}},
+      {"emin=0.2&emax=0.3&iterations=500", mesh, "model/obj", 422, {"iterations"}},
+      {"emin=0.2&emax=0.3&rings=0&flip_factor=7", mesh, "model/obj", 422, {"rings", "flip_factor"}},
+      {"emin=0.2&emax=0.3&bogus=1", mesh, "model/obj", 422, {"bogus"}},
+      {"emin=0.2&emax=0.3&format=fbx", mesh, "model/obj", 422, {"format"}},
+      {"emin=0.2&emax=0.3", "", "model/obj", 422, {"mesh"}},
+      {"emin=0.2&emax=0.3", "this is not a mesh", "application/octet-stream", 422, {}},
+      {"emin=0.2&emax=0.3", "v 0 0 0\nv 1 0 0\nf 1 2 3\n", "model/obj", 422, {}},
+      {"emin=0.001&emax=0.002", mesh, "model/obj", 413, {}},        // estimated output over the limit
+  };
+  for (const Row& row : rows) {
+    INFO(row.query << " / " << row.content_type << " / " << row.body.substr(0, 30));
+    auto r = submit_raw(c, row.body, row.query, row.content_type);
+    REQUIRE(r);
+    INFO(r->body);
+    CHECK(r->status == row.status);
+    CHECK(r->get_header_value("Content-Type") == "application/problem+json");
+    json p = body_of(r);
+    CHECK(p["status"] == row.status);
+    CHECK_FALSE(p["detail"].get<std::string>().empty());
+    if (!row.fields.empty()) CHECK(error_fields(r) == row.fields);
+  }
+  // The reader's message reaches the client.
+  auto bad = submit_raw(c, "v 0 0 0\nv 1 0 0\nf 1 2 3\n", "emin=0.2&emax=0.3", "model/obj");
+  REQUIRE(bad);
+  CHECK(body_of(bad)["detail"].get<std::string>().size() > 10);
+  // Faces over --max-faces: a sphere with 5120 faces.
+  auto big = submit_raw(c, sphere_obj(4), "emin=0.2&emax=0.3", "model/obj");
+  REQUIRE(big);
+  CHECK(big->status == 413);
+  // Multipart without the mesh field, and with broken params JSON.
+  httplib::MultipartFormDataItems no_mesh = {{"params", R"({"emin":1,"emax":2})", "", ""}};
+  auto nm = c.Post("/api/v1/jobs", no_mesh);
+  REQUIRE(nm);
+  CHECK(nm->status == 422);
+  CHECK(error_fields(nm) == std::set<std::string>{"mesh"});
+  httplib::MultipartFormDataItems bad_json = {{"mesh", mesh, "a.obj", ""}, {"params", "{emin:", "", ""}};
+  auto bj = c.Post("/api/v1/jobs", bad_json);
+  REQUIRE(bj);
+  CHECK(bj->status == 422);
+  CHECK(error_fields(bj) == std::set<std::string>{"params"});
+  // Nothing was stored for any refused upload.
+  CHECK(count_files(tmp.path / "data" / "jobs") == 0);
+
+  // Unknown and malformed ids.
+  for (const char* path : {"/api/v1/jobs/0123456789abcdef0123456789abcdef", "/api/v1/jobs/..%2F..%2Fetc",
+                           "/api/v1/jobs/xyz/stats", "/api/v1/jobs/0123456789abcdef0123456789abcdef/events",
+                           "/api/v1/jobs/0123456789abcdef0123456789abcdef/result"}) {
+    INFO(path);
+    auto r = c.Get(path);
+    REQUIRE(r);
+    CHECK(r->status == 404);
+    CHECK(r->get_header_value("Content-Type") == "application/problem+json");
+  }
+  CHECK(c.Delete("/api/v1/jobs/0123456789abcdef0123456789abcdef")->status == 404);
+  CHECK(c.Get("/api/v1/nothing")->status == 404);
+
+  // Query errors.
+  CHECK(c.Get("/api/v1/jobs?state=sleeping")->status == 422);
+  CHECK(c.Get("/api/v1/jobs?limit=-1")->status == 422);
+
+  // Results before success: 409 with the state; bad mesh/format: 422.
+  const std::string id = body_of(submit_raw(c, mesh, "emin=0.05&emax=0.08&iterations=50&run_all_iterations=true"))["id"];
+  auto early = c.Get(("/api/v1/jobs/" + id + "/result?mesh=remeshed&format=obj").c_str());
+  REQUIRE(early);
+  CHECK(early->status == 409);
+  std::string st = body_of(early)["state"];
+  CHECK((st == "queued" || st == "running"));
+  CHECK(c.Get(("/api/v1/jobs/" + id + "/result?mesh=dual&format=stl").c_str())->status == 422);
+  CHECK(c.Get(("/api/v1/jobs/" + id + "/result?mesh=remeshed&format=xyz").c_str())->status == 422);
+  CHECK(c.Get(("/api/v1/jobs/" + id + "/result?mesh=other").c_str())->status == 422);
+  CHECK(c.Get(("/api/v1/jobs/" + id + "/stats?format=xml").c_str())->status == 422);
+  CHECK(c.Get(("/api/v1/jobs/" + id + "/result?mesh=input&format=stl").c_str())->status == 200);
+  // A cancelled job has no results either.
+  auto del = c.Delete(("/api/v1/jobs/" + id).c_str());
+  REQUIRE(del);
+  CHECK(del->status == 202);
+  json cancelled = wait_final(c, id);
+  CHECK(cancelled["state"] == "cancelled");
+  auto late = c.Get(("/api/v1/jobs/" + id + "/result?mesh=dual&format=obj").c_str());
+  CHECK(late->status == 409);
+  CHECK(body_of(late)["state"] == "cancelled");
+}
+
+TEST_CASE("remeshd: the routes in api/openapi.yaml are the routes the server serves", "[server][openapi]") {
+  // Routes of the spec: "  /path:" then "    get:" etc.
+  std::ifstream in(REMESHD_OPENAPI);
+  REQUIRE(in);
+  std::set<std::pair<std::string, std::string>> spec;
+  std::string line, current;
+  bool in_paths = false;
+  while (std::getline(in, line)) {
+    if (line.rfind("paths:", 0) == 0) in_paths = true;
+    else if (!line.empty() && line[0] != ' ') in_paths = false;
+    if (!in_paths) continue;
+    std::smatch m;
+    if (std::regex_match(line, m, std::regex(R"(  (/\S*):\s*)"))) current = m[1];
+    else if (std::regex_match(line, m, std::regex(R"(    (get|post|put|patch|delete):\s*)"))) {
+      std::string method = m[1];
+      for (char& ch : method) ch = static_cast<char>(std::toupper(static_cast<unsigned char>(ch)));
+      spec.insert({method, current});
+    }
+  }
+  std::set<std::pair<std::string, std::string>> served;
+  for (const auto& r : remeshd::kRoutes) served.insert({r.method, r.path});
+  CHECK(spec == served);
+
+  // And each of them answers on the live server (not "no such route").
+  TempDir tmp;
+  Daemon d(tmp.path / "data");
+  auto c = d.client();
+  const std::string fake = "0123456789abcdef0123456789abcdef";
+  for (const auto& [method, path] : spec) {
+    std::string p = std::regex_replace(path, std::regex(R"(\{id\})"), fake);
+    INFO(method << " " << p);
+    httplib::Result r = method == "GET" ? c.Get(p.c_str())
+                        : method == "DELETE" ? c.Delete(p.c_str())
+                                             : c.Post(p.c_str(), "", "application/octet-stream");
+    REQUIRE(r);
+    CHECK(r->body.find("no such route") == std::string::npos);
+  }
+  auto yaml = c.Get("/api/v1/openapi.yaml");
+  REQUIRE(yaml);
+  CHECK(yaml->status == 200);
+  CHECK(yaml->body.rfind("openapi: 3", 0) == 0);
+}

@@ -1,0 +1,157 @@
+// Pieces of remeshd that need no process: options, static paths, SSE frames, storage.
+#include <catch2/catch.hpp>
+
+#include <cstdlib>
+#include <fstream>
+#include <random>
+
+#include "job_store.h"
+#include "options.h"
+#include "routes.h"
+#include "sse.h"
+#include "static_files.h"
+
+using namespace remeshd;
+namespace fs = std::filesystem;
+
+namespace {
+
+struct Args {
+  std::vector<std::string> items;
+  std::vector<char*> argv;
+  explicit Args(std::vector<std::string> a) : items(std::move(a)) {
+    items.insert(items.begin(), "remeshd");
+    for (auto& s : items) argv.push_back(s.data());
+  }
+  ParseResult parse() { return parse_options(static_cast<int>(argv.size()), argv.data()); }
+};
+
+fs::path temp_dir() {
+  std::random_device rd;
+  fs::path p = fs::temp_directory_path() / ("remeshd-unit-" + std::to_string(rd()));
+  fs::create_directories(p);
+  return p;
+}
+
+}  // namespace
+
+TEST_CASE("options: defaults, command line, environment, errors", "[server][options]") {
+  auto d = Args({}).parse();
+  REQUIRE(d.options);
+  CHECK(d.options->host == "127.0.0.1");
+  CHECK(d.options->port == 8080);
+  CHECK(d.options->max_upload_mb == 256);
+  CHECK_FALSE(d.options->data_dir.empty());
+
+  auto p = Args({"--port", "9000", "--workers=3", "--token", "t", "--log-format", "json", "--job-ttl-hours", "0.5"}).parse();
+  REQUIRE(p.options);
+  CHECK(p.options->port == 9000);
+  CHECK(p.options->workers == 3);
+  CHECK(p.options->token == "t");
+  CHECK(p.options->log_format == "json");
+  CHECK(p.options->job_ttl_hours == 0.5);
+
+  setenv("REMESHD_QUEUE_SIZE", "7", 1);
+  setenv("REMESHD_PORT", "9100", 1);
+  auto e = Args({"--port", "9200"}).parse();
+  unsetenv("REMESHD_QUEUE_SIZE");
+  unsetenv("REMESHD_PORT");
+  REQUIRE(e.options);
+  CHECK(e.options->queue_size == 7);
+  CHECK(e.options->port == 9200);  // the command line wins
+
+  for (auto bad : std::vector<std::vector<std::string>>{{"--port", "70000"},
+                                                         {"--port", "x"},
+                                                         {"--workers"},
+                                                         {"--log-format", "xml"},
+                                                         {"--frobnicate", "1"},
+                                                         {"stray"},
+                                                         {"--max-iterations", "0"}}) {
+    auto r = Args(bad).parse();
+    CHECK_FALSE(r.options);
+    CHECK(r.exit_code == 2);
+    CHECK(r.message.find('\n') == std::string::npos);
+  }
+  auto h = Args({"--help"}).parse();
+  CHECK_FALSE(h.options);
+  CHECK(h.exit_code == 0);
+  CHECK(h.message.find("--max-upload-mb") != std::string::npos);
+  CHECK(h.message.find("REMESHD_DATA_DIR") != std::string::npos);
+}
+
+TEST_CASE("static_file never leaves the web root", "[server][static]") {
+  fs::path root = temp_dir();
+  fs::create_directories(root / "web" / "sub");
+  std::ofstream(root / "web" / "index.html") << "x";
+  std::ofstream(root / "web" / "sub" / "a.js") << "x";
+  std::ofstream(root / "secret") << "x";
+  fs::create_symlink(root / "secret", root / "web" / "link");
+  fs::path web = root / "web";
+  CHECK(static_file(web, "/") == fs::canonical(web / "index.html"));
+  CHECK(static_file(web, "/sub/a.js") == fs::canonical(web / "sub" / "a.js"));
+  CHECK(static_file(web, "/sub//a.js").has_value());
+  for (const char* bad : {"/../secret", "/sub/../../secret", "/link", "/.hidden", "/sub/..", "relative",
+                          "/nothing.js", "/sub/a.js\\..", ""})
+    CHECK_FALSE(static_file(web, bad));
+  CHECK(mime_for("a.mjs").rfind("text/javascript", 0) == 0);
+  CHECK(mime_for("a.WASM") == "application/wasm");
+  CHECK(mime_for("a.map") == "application/json");
+  CHECK(mime_for("a.unknown") == "application/octet-stream");
+  fs::remove_all(root);
+}
+
+TEST_CASE("SSE frames and Last-Event-ID parsing", "[server][sse]") {
+  remesh::IterationStats row;
+  row.iteration = 7;
+  std::string f = sse_iteration(row);
+  CHECK(f.rfind("event: iteration\nid: 7\ndata: {", 0) == 0);
+  CHECK(f.substr(f.size() - 2) == "\n\n");
+  CHECK(sse_end(remesh::api::JobState::Failed) == "event: end\ndata: {\"state\":\"failed\"}\n\n");
+  CHECK(parse_last_event_id("12") == 12);
+  CHECK(parse_last_event_id(" 3 ") == 3);
+  CHECK_FALSE(parse_last_event_id(""));
+  CHECK_FALSE(parse_last_event_id("-1"));
+  CHECK_FALSE(parse_last_event_id("4x"));
+}
+
+TEST_CASE("route patterns", "[server][routes]") {
+  CHECK(route_pattern("/api/v1/jobs/{id}/events") == "/api/v1/jobs/([^/]+)/events");
+  CHECK(route_pattern("/api/v1/openapi.yaml") == "/api/v1/openapi\\.yaml");
+}
+
+TEST_CASE("JobStore: atomic job directories, torn stats lines, bad ids", "[server][storage]") {
+  fs::path root = temp_dir();
+  {
+    JobStore store(root);
+    remesh::api::JobRecord r;
+    r.id = remesh::api::new_job_id();
+    r.created_at = remesh::api::now_seconds();
+    r.params.e_min = 1;
+    r.params.e_max = 2;
+    r.format = "obj";
+    r.summary = nlohmann::json::object();
+    store.create(r, "v 0 0 0\n");
+    CHECK(store.read_upload(r.id) == "v 0 0 0\n");
+    remesh::IterationStats s;
+    s.iteration = 1;
+    store.append_stats(r.id, s);
+    s.iteration = 2;
+    store.append_stats(r.id, s);
+    { std::ofstream(store.file_path(r.id, "stats.jsonl"), std::ios::app) << "{\"iteration\":3,\"ver"; }
+    CHECK(store.load_stats(r.id).size() == 2);
+    std::vector<std::string> problems;
+    auto all = store.load_all(problems);
+    REQUIRE(all.size() == 1);
+    CHECK(all[0].record.id == r.id);
+    CHECK(problems.empty());
+    CHECK_THROWS(store.read_upload("../../etc/passwd"));
+    // Leftovers of an interrupted creation are cleaned at start.
+    fs::create_directories(root / "jobs" / ".tmp-abc");
+    fs::create_directories(root / "jobs" / "not-a-job");
+  }
+  JobStore again(root);
+  CHECK_FALSE(fs::exists(root / "jobs" / ".tmp-abc"));
+  std::vector<std::string> problems;
+  CHECK(again.load_all(problems).size() == 1);
+  fs::remove_all(root);
+}
