@@ -17,9 +17,11 @@ struct Outcome {
 };
 
 /// Reads one variant; FAILs on an unexpected exception type or an invalid mesh.
-void try_variant(const std::string& bytes, std::optional<Format> format, const std::string& what, Outcome& out) {
+void try_variant(const std::string& bytes, std::optional<Format> format, const std::string& what, Outcome& out,
+                 bool weld = false) {
   ReadOptions o;
   o.format = format;
+  o.weld = weld;
   try {
     LoadedMesh m = read_mesh(bytes, o);
     const std::string problem = test::check_loaded(m.mesh);
@@ -67,7 +69,7 @@ TEST_CASE("Garbled files give an error or a valid mesh") {
         where += std::to_string(at);
       }
       try_variant(bad, variant % 3 ? std::optional<Format>(file.format) : std::nullopt,
-                  file.name + " with bytes changed at" + where, outcome);
+                  file.name + " with bytes changed at" + where, outcome, variant % 4 == 1);
     }
     CHECK(outcome.errors > 0);
     CHECK(outcome.meshes > 1);
