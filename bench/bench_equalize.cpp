@@ -126,6 +126,7 @@ void print_row(const IterationStats& s) {
   std::printf("%4d %9zu %9zu %7.4f %7.4f %8.2f %7zu %7zu %8.3f %7zu %7zu %7zu %7.3f %8.4f\n", s.iteration,
               s.vertices, s.edges, s.mean, s.deviation, s.regular_percent, s.small, s.big, 100 * s.inside_fraction,
               s.splits, s.collapses, s.flips, s.seconds, s.max_projection_distance);
+  std::fflush(stdout);
 }
 
 const char* outcome_name(Outcome o) {

@@ -1,6 +1,7 @@
 #include "remesh/low_pass_filter.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 
 #include "core/parallel.h"
@@ -55,12 +56,26 @@ Vec3 ring_centroid(const TriMesh& mesh, OpenMesh::VertexHandle v, int rings) {
 
 }  // namespace
 
+bool is_corner(const TriMesh& mesh, OpenMesh::VertexHandle v) {
+  double angles = 0;
+  for (auto h : mesh.voh_range(v)) {
+    if (mesh.is_boundary(h)) return false;
+    const Vec3 a = mesh.point(mesh.to_vertex_handle(h)) - mesh.point(v);
+    const Vec3 b = mesh.point(mesh.to_vertex_handle(mesh.next_halfedge_handle(h))) - mesh.point(v);
+    const double na = a.norm(), nb = b.norm();
+    if (!(na > 0) || !(nb > 0)) return false;
+    angles += std::acos(std::clamp((a | b) / (na * nb), -1.0, 1.0));
+  }
+  return std::abs(2 * M_PI - angles) > kCornerDeficit;
+}
+
 std::vector<Vec3> low_pass_displacements(const TriMesh& mesh, int rings, unsigned threads) {
   const std::vector<Vec3> normals = geom::vertex_normals(mesh, threads);
   std::vector<Vec3> moves(mesh.n_vertices(), Vec3(0, 0, 0));
   parallel_for(mesh.n_vertices(), threads, [&](std::size_t i) {
     const auto v = mesh.vertex_handle(static_cast<unsigned>(i));
     if (mesh.status(v).deleted() || mesh.is_boundary(v)) return;  // isolated counts as boundary
+    if (is_corner(mesh, v)) return;
     Vec3 t = ring_centroid(mesh, v, rings) - mesh.point(v);
     const Vec3& n = normals[i];
     t -= n * (t | n);
