@@ -71,13 +71,23 @@ std::map<std::string, std::string> query_params(const httplib::Request& req) {
 
 }  // namespace
 
+/// httplib::Server with a larger accept backlog: 0.11.4 listens with a backlog of 5, so a burst of
+/// connections (a page opening several streams, many clients) waits for SYN retransmits (1 s+).
+class BackloggedServer : public httplib::Server {
+ public:
+  void widen_backlog() {
+    socket_t s = svr_sock_;
+    if (s != INVALID_SOCKET) ::listen(s, SOMAXCONN);
+  }
+};
+
 struct HttpServer::Impl {
   Options options;
   JobManager& jobs;
   Metrics& metrics;
   Logger& log;
   std::filesystem::path web_root;
-  httplib::Server server;
+  BackloggedServer server;
   std::atomic<std::size_t> streams{0};
   std::vector<std::pair<std::regex, std::string>> route_labels;
   std::chrono::steady_clock::time_point started = std::chrono::steady_clock::now();
@@ -607,6 +617,7 @@ int HttpServer::bind() {
   if (port == 0) port = impl_->server.bind_to_any_port(o.host);
   else if (!impl_->server.bind_to_port(o.host, port)) port = -1;
   if (port <= 0) throw std::runtime_error("cannot listen on " + o.host + ":" + std::to_string(o.port));
+  impl_->server.widen_backlog();
   return port;
 }
 

@@ -1,0 +1,137 @@
+// Benchmark (not a test): with 2 jobs running on 2 workers and 64 SSE clients connected, measures
+//   - SSE delivery delay: from an iteration's row being stored (stats.jsonl grows; polled every
+//     0.5 ms) to each client receiving the event;
+//   - /healthz latency percentiles, polled every 20 ms meanwhile.
+// usage: bench_remeshd [clients=64] [subdiv=4] [iterations=40]
+#include <algorithm>
+#include <cstdlib>
+#include <fstream>
+#include <atomic>
+#include <cstdio>
+#include <mutex>
+#include <thread>
+
+#include "daemon.h"
+
+using namespace remesh::test;
+using nlohmann::json;
+using Clock = std::chrono::steady_clock;
+
+namespace {
+
+double ms_since(Clock::time_point t0, Clock::time_point t) {
+  return std::chrono::duration<double, std::milli>(t - t0).count();
+}
+
+double percentile(std::vector<double> v, double p) {
+  if (v.empty()) return 0;
+  std::sort(v.begin(), v.end());
+  return v[std::min(v.size() - 1, static_cast<std::size_t>(p / 100.0 * (v.size() - 1) + 0.5))];
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  int clients = argc > 1 ? std::atoi(argv[1]) : 64;
+  int subdiv = argc > 2 ? std::atoi(argv[2]) : 4;
+  int iterations = argc > 3 ? std::atoi(argv[3]) : 40;
+  TempDir tmp;
+  Daemon d(tmp.path / "data", {"--workers", "2", "--max-streams", std::to_string(clients + 8)});
+  auto c = d.client();
+  std::string query = "emin=0.03&emax=0.05&run_all_iterations=true&iterations=" + std::to_string(iterations);
+  std::vector<std::string> ids;
+  for (int i = 0; i < 2; ++i) {
+    auto r = submit_raw(c, sphere_obj(subdiv), query);
+    if (!r || r->status != 202) {
+      std::fprintf(stderr, "submit failed\n");
+      return 1;
+    }
+    ids.push_back(json::parse(r->body)["id"]);
+  }
+  const Clock::time_point t0 = Clock::now();
+
+  // Row stored: watch each job's stats.jsonl grow.
+  std::mutex mutex;
+  std::vector<std::vector<double>> stored(2, std::vector<double>(iterations + 1, -1));
+  std::atomic<bool> done{false};
+  std::thread watcher([&] {
+    std::vector<std::uintmax_t> lines(2, 0);
+    while (!done) {
+      for (int j = 0; j < 2; ++j) {
+        std::ifstream in(tmp.path / "data" / "jobs" / ids[j] / "stats.jsonl");
+        std::string line;
+        std::uintmax_t n = 0;
+        while (std::getline(in, line)) ++n;
+        double now = ms_since(t0, Clock::now());
+        std::lock_guard lock(mutex);
+        for (std::uintmax_t k = lines[j] + 1; k <= n && k <= static_cast<std::uintmax_t>(iterations); ++k)
+          stored[j][k] = now;
+        lines[j] = std::max(lines[j], n);
+      }
+      std::this_thread::sleep_for(std::chrono::microseconds(500));
+    }
+  });
+
+  // SSE clients: arrival time of every iteration event.
+  std::vector<double> delays;
+  std::vector<std::thread> readers;
+  std::atomic<int> ended{0};
+  for (int i = 0; i < clients; ++i)
+    readers.emplace_back([&, i] {
+      int job = i % 2;
+      httplib::Client sc("127.0.0.1", d.port());
+      sc.set_read_timeout(300);
+      std::string buffer, id;
+      std::vector<std::pair<int, double>> arrivals;
+      double connected = -1;  // rows stored before this are history replay, not delivery
+      sc.Get(("/api/v1/jobs/" + ids[job] + "/events").c_str(), [&](const char* data, size_t n) {
+        double now = ms_since(t0, Clock::now());
+        if (connected < 0) connected = now;
+        buffer.append(data, n);
+        std::size_t pos;
+        while ((pos = buffer.find('\n')) != std::string::npos) {
+          std::string line = buffer.substr(0, pos);
+          buffer.erase(0, pos + 1);
+          if (line.rfind("id: ", 0) == 0) arrivals.emplace_back(std::stoi(line.substr(4)), now);
+          if (line == "event: end") ++ended;
+        }
+        return true;
+      });
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));  // let the watcher catch up
+      std::lock_guard lock(mutex);
+      for (auto [it, when] : arrivals)
+        if (it >= 1 && it <= iterations && stored[job][it] >= connected && stored[job][it] <= when)
+          delays.push_back(when - stored[job][it]);
+    });
+
+  // /healthz meanwhile.
+  std::vector<double> health;
+  int health_failed = 0;
+  while (ended.load() < clients) {
+    httplib::Client h("127.0.0.1", d.port());
+    h.set_read_timeout(10);
+    auto t = Clock::now();
+    auto r = h.Get("/healthz");
+    double ms = ms_since(t, Clock::now());
+    if (r && r->status == 200) health.push_back(ms);
+    else ++health_failed;
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    if (ms_since(t0, Clock::now()) > 600'000) break;
+  }
+  for (auto& t : readers) t.join();
+  done = true;
+  watcher.join();
+  json job = get_job(c, ids[0]);
+  std::printf("remeshd bench: 2 jobs (icosphere subdiv %d -> ~%d faces, %d iterations) on 2 workers, %d SSE clients\n",
+              subdiv, job["latest"].is_null() ? 0 : static_cast<int>(job["latest"]["edges"].get<double>() * 2 / 3),
+              iterations, clients);
+  std::printf("  run time %.1f s, mean iteration %.1f ms\n", ms_since(t0, Clock::now()) / 1000,
+              job["timings"]["run_seconds"].get<double>() * 1000 / iterations);
+  std::printf("  SSE delivery delay (row stored -> client), %zu samples: p50 %.2f ms  p90 %.2f ms  p99 %.2f ms  max %.2f ms\n",
+              delays.size(), percentile(delays, 50), percentile(delays, 90), percentile(delays, 99),
+              percentile(delays, 100));
+  std::printf("  /healthz latency, %zu requests (%d failed): p50 %.2f ms  p90 %.2f ms  p99 %.2f ms  max %.2f ms\n",
+              health.size(), health_failed, percentile(health, 50), percentile(health, 90), percentile(health, 99),
+              percentile(health, 100));
+  return 0;
+}
