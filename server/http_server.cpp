@@ -326,7 +326,13 @@ void HttpServer::Impl::post_job(const httplib::Request& req, httplib::Response& 
     return;
   }
   if (!ok) {
-    send_problem(res, 400, "the request body could not be read (malformed or interrupted upload)");
+    std::string type = req.get_header_value("Content-Type");
+    auto b = type.find("boundary=");
+    if (req.is_multipart_form_data() && b != std::string::npos && type.find(';', b) != std::string::npos)
+      send_problem(res, 400, "multipart/form-data: nothing may follow the boundary parameter (drop '" +
+                                 type.substr(type.find(';', b)).substr(0, 40) + "')");
+    else
+      send_problem(res, 400, "the request body could not be read (malformed or interrupted upload)");
     return;
   }
 
