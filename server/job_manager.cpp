@@ -409,6 +409,9 @@ void JobManager::expire() {
   std::map<std::string, std::uint64_t> sizes;
   for (const std::string& id : all) total += sizes[id] = store_.job_bytes(id);
   std::sort(finished.begin(), finished.end());
+  // Oldest first; the newest finished job is kept even if it alone is over the cap (its owner has
+  // not had a chance to download it yet).
+  if (!finished.empty()) finished.pop_back();
   for (const auto& [when, id] : finished) {
     if (total <= config_.data_cap_bytes) break;
     store_.remove(id);

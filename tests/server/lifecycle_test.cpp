@@ -264,7 +264,20 @@ TEST_CASE("remeshd: SIGTERM interrupts running jobs without losing them; expiry"
     auto c = d.client();
     id = submit(c, sphere_obj(4), "emin=0.05&emax=0.08&iterations=10&run_all_iterations=true");
     wait_job(c, id, running_with_rows);
+    // An open event stream does not hold the shutdown up: it ends with a retry hint.
+    SseStream stream;
+    std::thread reader([&] { stream = read_events(d.port(), "/api/v1/jobs/" + id + "/events", {}, 30); });
+    for (int i = 0; i < 200; ++i) {
+      auto h = c.Get("/healthz");
+      if (h && json::parse(h->body)["event_streams"] == 1) break;
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+    auto t0 = std::chrono::steady_clock::now();
     CHECK(d.stop(SIGTERM) == 0);
+    reader.join();
+    CHECK(std::chrono::steady_clock::now() - t0 < std::chrono::seconds(8));
+    CHECK(stream.completed);
+    CHECK(stream.retries.size() >= 2);
   }
   {
     // A TTL of ~2 s: the job runs again to the end, then expires.
@@ -279,4 +292,28 @@ TEST_CASE("remeshd: SIGTERM interrupts running jobs without losing them; expiry"
     CHECK(gone);
     CHECK_FALSE(std::filesystem::exists(data / "jobs" / id));
   }
+}
+
+TEST_CASE("remeshd: the data cap removes the oldest finished jobs first, keeps the newest", "[server][storage]") {
+  TempDir tmp;
+  Daemon d(tmp.path / "data", {"--workers", "1", "--data-cap-mb", "1"});
+  auto c = d.client();
+  // Each job stores well over 1 MiB (upload, 10 result files).
+  const char* q = "emin=0.03&emax=0.05&iterations=2";
+  const std::string first = submit(c, sphere_obj(4), q);
+  REQUIRE(wait_final(c, first)["state"] == "succeeded");
+  const std::string second = submit(c, sphere_obj(4), q);
+  REQUIRE(wait_final(c, second)["state"] == "succeeded");
+  bool first_gone = false;
+  for (int i = 0; i < 300 && !first_gone; ++i) {
+    first_gone = c.Get(("/api/v1/jobs/" + first).c_str())->status == 404;
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  CHECK(first_gone);
+  CHECK_FALSE(std::filesystem::exists(tmp.path / "data" / "jobs" / first));
+  // Oldest first, and the newest finished job stays (even alone over the cap).
+  json list = json::parse(c.Get("/api/v1/jobs")->body);
+  REQUIRE(list["jobs"].size() == 1);
+  CHECK(list["jobs"][0]["id"] == second);
+  CHECK(c.Get(("/api/v1/jobs/" + second + "/result?mesh=dual&format=obj").c_str())->status == 200);
 }
