@@ -156,6 +156,11 @@ void HttpServer::Impl::setup() {
   unsigned threads = options.http_threads ? options.http_threads : options.max_streams + 16;
   server.new_task_queue = [threads] { return new httplib::ThreadPool(threads); };
   server.set_payload_max_length(options.max_upload_mb * kMiB + kMiB);  // Content-Length; chunked counted below
+  // httplib's default also sets SO_REUSEPORT, which lets a second daemon bind the same port.
+  server.set_socket_options([](socket_t sock) {
+    int yes = 1;
+    ::setsockopt(sock, SOL_SOCKET, SO_REUSEADDR, reinterpret_cast<const void*>(&yes), sizeof(yes));
+  });
   server.set_keep_alive_timeout(5);
   server.set_read_timeout(30);
   server.set_write_timeout(30);

@@ -1,6 +1,7 @@
 #include "job_store.h"
 
 #include <fcntl.h>
+#include <sys/file.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -84,6 +85,14 @@ JobStore::JobStore(fs::path data_dir) : root_(std::move(data_dir) / "jobs") {
   fs::create_directories(root_, ec);
   if (ec || !fs::is_directory(root_))
     throw std::runtime_error("cannot use data directory " + root_.parent_path().string() + ": " + ec.message());
+  fs::path lock = root_.parent_path() / "lock";
+  lock_fd_ = ::open(lock.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+  if (lock_fd_ < 0) fail("cannot open", lock);
+  if (::flock(lock_fd_, LOCK_EX | LOCK_NB) != 0) {
+    ::close(lock_fd_);
+    throw std::runtime_error("data directory " + root_.parent_path().string() +
+                             " is in use by another remeshd (lock held on " + lock.string() + ")");
+  }
   for (const auto& entry : fs::directory_iterator(root_, ec)) {
     std::string name = entry.path().filename().string();
     if (name.rfind(".tmp-", 0) == 0) fs::remove_all(entry.path(), ec);
@@ -94,6 +103,10 @@ JobStore::JobStore(fs::path data_dir) : root_(std::move(data_dir) / "jobs") {
     for (const auto& f : fs::directory_iterator(entry.path(), ec))
       if (f.path().filename().string().find(".tmp-") != std::string::npos) fs::remove(f.path(), ec);
   }
+}
+
+JobStore::~JobStore() {
+  if (lock_fd_ >= 0) ::close(lock_fd_);
 }
 
 fs::path JobStore::dir(const std::string& id) const {

@@ -27,9 +27,13 @@ std::string read_file(const std::filesystem::path& path);
 
 class JobStore {
  public:
-  /// Creates <data_dir>/jobs if needed and removes leftovers of interrupted creations.
-  /// Throws std::runtime_error if the directory cannot be used.
+  /// Creates <data_dir>/jobs if needed, locks <data_dir>/lock (one daemon per directory) and
+  /// removes leftovers of interrupted creations. Throws std::runtime_error if the directory cannot
+  /// be used or another process holds it.
   explicit JobStore(std::filesystem::path data_dir);
+  ~JobStore();
+  JobStore(const JobStore&) = delete;
+  JobStore& operator=(const JobStore&) = delete;
 
   const std::filesystem::path& root() const { return root_; }
 
@@ -65,6 +69,7 @@ class JobStore {
  private:
   std::filesystem::path dir(const std::string& id) const;
   std::filesystem::path root_;  ///< <data_dir>/jobs
+  int lock_fd_ = -1;            ///< flock()ed <data_dir>/lock
 };
 
 }  // namespace remeshd

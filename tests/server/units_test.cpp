@@ -150,6 +150,7 @@ TEST_CASE("JobStore: atomic job directories, torn stats lines, bad ids", "[serve
     fs::create_directories(root / "jobs" / "not-a-job");
   }
   JobStore again(root);
+  CHECK_THROWS_WITH(JobStore(root), Catch::Contains("in use by another remeshd"));  // one daemon per dir
   CHECK_FALSE(fs::exists(root / "jobs" / ".tmp-abc"));
   std::vector<std::string> problems;
   CHECK(again.load_all(problems).size() == 1);
