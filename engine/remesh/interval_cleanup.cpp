@@ -141,11 +141,15 @@ class Cleanup {
     return true;
   }
 
-  std::size_t outside_around(VertexHandle v, const Vec3& p) const {
+  /// Edges of v's star outside the interval with v at p, and the sum of their squared excess.
+  std::pair<std::size_t, double> outside_around(VertexHandle v, const Vec3& p) const {
     std::size_t n = 0;
-    for (auto w : mesh_.vv_range(v))
-      if (!inside((mesh_.point(w) - p).norm())) ++n;
-    return n;
+    double excess = 0;
+    for (auto w : mesh_.vv_range(v)) {
+      const double d = outside_by((mesh_.point(w) - p).norm());
+      if (d > 0) ++n, excess += d * d;
+    }
+    return {n, excess};
   }
 
   /// Direction a boundary vertex may slide along (its boundary curve), or zero at a corner
@@ -191,7 +195,11 @@ class Cleanup {
       x -= grad * (1.0 / active);
     }
     const Vec3 p = boundary ? reference_.closest_boundary_point(x) : reference_.closest_point(x, n);
-    if (outside_around(v, p) >= outside_around(v, start)) return false;
+    // Progress: fewer star edges outside, or as many but closer to the interval (a strictly
+    // decreasing measure, so rounds cannot cycle).
+    const auto [n_before, e_before] = outside_around(v, start);
+    const auto [n_after, e_after] = outside_around(v, p);
+    if (n_after > n_before || (n_after == n_before && !(e_after < 0.9 * e_before))) return false;
     if (!geom::move_is_safe(mesh_, v, p)) return false;
     mesh_.point(v) = p;
     return true;
