@@ -27,6 +27,18 @@ using remesh::api::make_problem;
 
 namespace {
 
+// Sends bytes uncompressed. httplib 0.11.4 brotli-compresses every set_content() body at its
+// slowest setting when the client accepts br (browsers always do): seconds for three.js or a big
+// OBJ. A content provider is never compressed.
+void send_bytes(httplib::Response& res, std::string bytes, const std::string& mime) {
+  auto data = std::make_shared<std::string>(std::move(bytes));
+  const std::size_t size = data->size();
+  res.set_content_provider(size, mime,
+                           [data](std::size_t offset, std::size_t length, httplib::DataSink& sink) {
+                             return sink.write(data->data() + offset, length);
+                           });
+}
+
 constexpr const char* kPrefix = "/api/v1";
 constexpr std::size_t kMiB = 1024 * 1024;
 constexpr std::size_t kMaxParamsBytes = 64 * 1024;
@@ -571,7 +583,7 @@ void HttpServer::Impl::result(const httplib::Request& req, httplib::Response& re
   res.set_header("Content-Disposition", "attachment; filename=\"" + name + "\"");
   auto f = remesh::parse_format(format);
   res.status = 200;
-  res.set_content(std::move(bytes), f ? std::string(remesh::mime_type(*f)) : "application/octet-stream");
+  send_bytes(res, std::move(bytes), f ? std::string(remesh::mime_type(*f)) : "application/octet-stream");
 }
 
 void HttpServer::Impl::stats(const httplib::Request& req, httplib::Response& res) {
@@ -611,7 +623,7 @@ void HttpServer::Impl::static_files(const httplib::Request& req, httplib::Respon
     return;
   }
   res.set_header("Cache-Control", "no-cache");
-  res.set_content(read_file(*file), mime_for(*file));
+  send_bytes(res, read_file(*file), mime_for(*file));
 }
 
 HttpServer::HttpServer(const Options& options, JobManager& jobs, Metrics& metrics, Logger& log,
