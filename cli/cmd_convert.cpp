@@ -27,13 +27,8 @@ int run_convert(const std::vector<std::string>& args) {
     return 0;
   }
   const Args a = parse_args(args, kSpec, 2, 2);
-  const std::string& in = a.positional[0];
   const std::string& out = a.positional[1];
-  require_input_file(in);
-  require_output_format(out);
-  ReadOptions options;
-  options.weld = a.has("weld");
-  const LoadedMesh loaded = read_mesh_file(in, options);
+  const LoadedMesh loaded = read_input_for(a.positional[0], out, a.has("weld"));
   write_mesh_file(to_soup(loaded.mesh), out);
   if (!a.has("quiet")) {
     print_repairs(std::cerr, loaded.repairs);

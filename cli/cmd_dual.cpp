@@ -44,13 +44,8 @@ int run_dual(const std::vector<std::string>& args) {
     return 0;
   }
   const Args a = parse_args(args, kSpec, 2, 2);
-  const std::string& in = a.positional[0];
   const std::string& out = a.positional[1];
-  require_input_file(in);
-  require_output_format(out);
-  ReadOptions options;
-  options.weld = a.has("weld");
-  const LoadedMesh loaded = read_mesh_file(in, options);
+  const LoadedMesh loaded = read_input_for(a.positional[0], out, a.has("weld"));
   const PolyMesh dual = trivalent_dual(loaded.mesh);
   write_mesh_file(to_soup(dual), out);
   if (!a.has("quiet")) {

@@ -23,6 +23,9 @@ void require_input_file(const std::string& path);
 /// The format to write `path` in, from its extension. Throws UsageError for an unknown extension
 /// and for .gltf (only the binary .glb is written), and when the directory of `path` does not exist.
 Format require_output_format(const std::string& path);
+/// The prologue of commands that read IN and write OUT: checks IN exists and OUT's format and
+/// directory before reading (so no work is wasted on a bad OUT), then reads IN.
+LoadedMesh read_input_for(const std::string& in, const std::string& out, bool weld);
 /// One line per repair ("  kind (count): detail"); nothing when there were none.
 void print_repairs(std::ostream& out, const std::vector<Repair>& repairs);
 

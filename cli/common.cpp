@@ -36,4 +36,12 @@ void print_repairs(std::ostream& out, const std::vector<Repair>& repairs) {
   for (const auto& r : repairs) out << "  " << r.kind << " (" << r.count << "): " << r.detail << "\n";
 }
 
+LoadedMesh read_input_for(const std::string& in, const std::string& out, bool weld) {
+  require_input_file(in);
+  require_output_format(out);
+  ReadOptions options;
+  options.weld = weld;
+  return read_mesh_file(in, options);
+}
+
 }  // namespace remesh::cli

@@ -47,6 +47,15 @@ struct ReferenceSurface::Impl {
   std::size_t neighbours = 30;
   PointCloud cloud;
   std::unique_ptr<KdTree> tree;
+
+  static constexpr std::size_t kMaxK = 64;
+  /// The min(neighbours, kMaxK) reference vertices nearest to p, nearest first, into idx.
+  std::size_t nearest(const Vec3& p, std::uint32_t (&idx)[kMaxK]) const {
+    double dist2[kMaxK];
+    const std::size_t k = std::min({neighbours, kMaxK, points.size()});
+    const double q[3] = {p[0], p[1], p[2]};
+    return tree->knnSearch(q, k, idx, dist2);
+  }
 };
 
 ReferenceSurface::ReferenceSurface(const TriMesh& mesh, std::size_t neighbours)
@@ -126,12 +135,8 @@ bool ReferenceSurface::has_boundary() const { return impl_->boundary_edges > 0; 
 
 Vec3 ReferenceSurface::closest_point(const Vec3& p, const Vec3& normal_hint) const {
   const Impl& m = *impl_;
-  constexpr std::size_t kMaxK = 64;
-  std::uint32_t idx[kMaxK];
-  double dist2[kMaxK];
-  const std::size_t k = std::min({m.neighbours, kMaxK, m.points.size()});
-  const double q[3] = {p[0], p[1], p[2]};
-  const std::size_t found = m.tree->knnSearch(q, k, idx, dist2);
+  std::uint32_t idx[Impl::kMaxK];
+  const std::size_t found = m.nearest(p, idx);
 
   // Best candidate overall and best candidate whose normal agrees with the hint. The agreeing one
   // wins when it is nearly as close (two sheets close together: stay on the vertex's own sheet).
@@ -169,12 +174,8 @@ Vec3 ReferenceSurface::closest_point(const Vec3& p, const Vec3& normal_hint) con
 Vec3 ReferenceSurface::closest_boundary_point(const Vec3& p) const {
   const Impl& m = *impl_;
   if (m.boundary_edges == 0) return closest_point(p);
-  constexpr std::size_t kMaxK = 64;
-  std::uint32_t idx[kMaxK];
-  double dist2[kMaxK];
-  const std::size_t k = std::min({m.neighbours, kMaxK, m.points.size()});
-  const double q[3] = {p[0], p[1], p[2]};
-  const std::size_t found = m.tree->knnSearch(q, k, idx, dist2);
+  std::uint32_t idx[Impl::kMaxK];
+  const std::size_t found = m.nearest(p, idx);
   Vec3 best(0, 0, 0);
   double best_d2 = std::numeric_limits<double>::max();
   for (std::size_t i = 0; i < found; ++i) {
