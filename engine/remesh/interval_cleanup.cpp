@@ -60,6 +60,8 @@ class Cleanup {
         ++counts.splits;
       } else if (try_relocate(e)) {
         ++counts.relocations;
+      } else if (try_relax_patch(e)) {
+        ++counts.patches;
       } else {
         continue;
       }
@@ -93,13 +95,25 @@ class Cleanup {
   }
 
   bool try_collapse(EdgeHandle e) {
+    if (collapse_at(e, e_max_, false)) return true;
+    // The eq. 3.1 point leaves an edge outside (typically a valence-4 vertex among short edges:
+    // merging it with a neighbour makes the far corner of its star too far). Plan again with the
+    // main phase's looser length bound and place the merged vertex freely in its tangent plane.
+    return collapse_at(e, 2.0 * e_max_, true);
+  }
+
+  bool collapse_at(EdgeHandle e, double plan_limit, bool free_placement) {
     CollapsePlan plan;
-    if (!plan_collapse(mesh_, e, target(), e_max_, sizes_, plan)) return false;
+    if (!plan_collapse(mesh_, e, target(), plan_limit, sizes_, plan)) return false;
     const VertexHandle kept = mesh_.to_vertex_handle(plan.halfedge);
     const VertexHandle removed = mesh_.from_vertex_handle(plan.halfedge);
+    const bool on_boundary = mesh_.is_boundary(kept) || mesh_.is_boundary(removed);
+    if (free_placement && on_boundary) return false;  // a boundary vertex stays where plan_collapse put it
+    const Vec3 normal = normal_at(kept) + normal_at(removed);
     Vec3 p = plan.position;
+    if (free_placement) p = settle(p, collapse_neighbours(mesh_, plan.halfedge), normal);
     if (!mesh_.is_boundary(kept) || mesh_.is_boundary(mesh_.edge_handle(plan.halfedge)))
-      p = project_vertex(mesh_, kept, p, normal_at(kept) + normal_at(removed), reference_);
+      p = project_vertex(mesh_, kept, p, normal, reference_);
     if (!collapse_geometry_ok(mesh_, plan.halfedge, p, e_max_)) return false;
     for (VertexHandle end : {kept, removed})
       for (auto w : mesh_.vv_range(end))
@@ -110,18 +124,64 @@ class Cleanup {
     return true;
   }
 
+  /// Gradient steps from `x`, within the plane orthogonal to `normal` (or along `tangent` when it is
+  /// non-zero), on the sum of squared distances of |x - q| to the interval (shrunk by a margin) over
+  /// the points q. Not projected.
+  Vec3 settle(Vec3 x, const std::vector<Vec3>& points, Vec3 normal, const Vec3& tangent = Vec3(0, 0, 0)) const {
+    const double len = normal.norm();
+    if (len > 0) normal /= len;
+    const double margin = 0.05 * (e_max_ - e_min_);
+    const double lo = e_min_ + margin, hi = e_max_ - margin;
+    for (int it = 0; it < 30; ++it) {
+      Vec3 grad(0, 0, 0);
+      int active = 0;
+      for (const Vec3& q : points) {
+        const Vec3 d = x - q;
+        const double l = d.norm();
+        if (!(l > 0)) continue;
+        const double excess = l < lo ? l - lo : (l > hi ? l - hi : 0.0);
+        if (excess == 0) continue;
+        grad += d * (excess / l);
+        ++active;
+      }
+      if (active == 0) break;
+      if (tangent.sqrnorm() > 0) {
+        grad = tangent * (grad | tangent);  // slide along the boundary curve
+      } else {
+        grad -= normal * (grad | normal);  // stay in the tangent plane
+      }
+      x -= grad * (1.0 / active);
+    }
+    return x;
+  }
+
   bool try_split(EdgeHandle e) {
     const HalfedgeHandle h = mesh_.halfedge_handle(e, 0);
     const VertexHandle v0 = mesh_.from_vertex_handle(h), v1 = mesh_.to_vertex_handle(h);
     const Vec3 a = mesh_.point(v0), b = mesh_.point(v1);
-    Vec3 p = a + (b - a) * equalizing_parameter(a, b, split_neighbours(mesh_, e), target());
-    if (mesh_.is_boundary(e)) {
-      p = reference_.has_boundary() ? reference_.closest_boundary_point(p) : p;
-    } else {
-      p = reference_.closest_point(p, normal_at(v0) + normal_at(v1));
+    const std::vector<Vec3> around = split_neighbours(mesh_, e);
+    const Vec3 normal = normal_at(v0) + normal_at(v1);
+    const Vec3 p0 = a + (b - a) * equalizing_parameter(a, b, around, target());
+    auto project = [&](const Vec3& x) {
+      if (!mesh_.is_boundary(e)) return reference_.closest_point(x, normal);
+      return reference_.has_boundary() ? reference_.closest_boundary_point(x) : x;
+    };
+    Vec3 p = project(p0);
+    // The eq. 3.1 point leaves an edge outside: place the new vertex freely in the tangent plane
+    // (along the edge on the boundary).
+    if (!split_point_fits(e, p, around)) {
+      const Vec3 along = mesh_.is_boundary(e) ? (b - a).normalized() : Vec3(0, 0, 0);
+      p = project(settle(p0, around, normal, along));
+      if (!split_point_fits(e, p, around)) return false;
     }
-    // New edges inside, new triangles unfolded and not degenerate.
-    for (const Vec3& q : split_neighbours(mesh_, e))
+    const VertexHandle v = mesh_.split(e, p);
+    sizes_.on_split(v, v0);
+    return true;
+  }
+
+  /// Would splitting e at p give edges inside the interval and unfolded, non-degenerate triangles?
+  bool split_point_fits(EdgeHandle e, const Vec3& p, const std::vector<Vec3>& around) const {
+    for (const Vec3& q : around)
       if (!inside((q - p).norm())) return false;
     for (int s = 0; s < 2; ++s) {
       const HalfedgeHandle g = mesh_.halfedge_handle(e, s);
@@ -136,8 +196,6 @@ class Cleanup {
         if (geom::min_angle(u, w, z) < floor_angle) return false;
       }
     }
-    const VertexHandle v = mesh_.split(e, p);
-    sizes_.on_split(v, v0);
     return true;
   }
 
@@ -171,29 +229,9 @@ class Cleanup {
     if (boundary && tangent.sqrnorm() == 0) return false;
     const Vec3 start = mesh_.point(v);
     const Vec3 n = normal_at(v);
-    const double margin = 0.05 * (e_max_ - e_min_);
-    const double lo = e_min_ + margin, hi = e_max_ - margin;
-    Vec3 x = start;
-    for (int it = 0; it < 30; ++it) {
-      Vec3 grad(0, 0, 0);
-      int active = 0;
-      for (auto w : mesh_.vv_range(v)) {
-        const Vec3 d = x - mesh_.point(w);
-        const double l = d.norm();
-        if (!(l > 0)) continue;
-        const double excess = l < lo ? l - lo : (l > hi ? l - hi : 0.0);
-        if (excess == 0) continue;
-        grad += d * (excess / l);
-        ++active;
-      }
-      if (active == 0) break;
-      if (boundary) {
-        grad = tangent * (grad | tangent);  // slide along the boundary curve
-      } else {
-        grad -= n * (grad | n);  // stay in the tangent plane
-      }
-      x -= grad * (1.0 / active);
-    }
+    std::vector<Vec3> ring;
+    for (auto w : mesh_.vv_range(v)) ring.push_back(mesh_.point(w));
+    const Vec3 x = settle(start, ring, n, tangent);
     const Vec3 p = boundary ? reference_.closest_boundary_point(x) : reference_.closest_point(x, n);
     // Progress: fewer star edges outside, or as many but closer to the interval (a strictly
     // decreasing measure, so rounds cannot cycle).
@@ -217,11 +255,69 @@ class Cleanup {
     return false;
   }
 
+  /// Spreads the strain of a stubborn edge over its neighbourhood: the interior vertices within
+  /// kPatchRings rings of e take a few Gauss-Seidel rounds of the relocation (settle, project, keep
+  /// the move only if it folds nothing). The patch keeps its new positions only if fewer of its
+  /// edges lie outside the interval, or as many but with 10 % less squared excess; else every
+  /// vertex goes back. (An edge of 1.98 between six regular vertices cannot be split, its halves
+  /// would be short, nor fixed by moving one end, whose other edges are at their limits.)
+  bool try_relax_patch(EdgeHandle e) {
+    const HalfedgeHandle h = mesh_.halfedge_handle(e, 0);
+    std::vector<VertexHandle> patch{mesh_.from_vertex_handle(h), mesh_.to_vertex_handle(h)};
+    std::vector<char>& in = patch_mark_;
+    if (in.size() < mesh_.n_vertices()) in.assign(mesh_.n_vertices(), 0);
+    for (auto v : patch) in[v.idx()] = 1;
+    for (std::size_t begin = 0, r = 0; r < kPatchRings; ++r) {
+      const std::size_t end = patch.size();
+      for (std::size_t i = begin; i < end; ++i)
+        for (auto w : mesh_.vv_range(patch[i]))
+          if (!in[w.idx()]) in[w.idx()] = 1, patch.push_back(w);
+      begin = end;
+    }
+    // Edges of the patch: those with an end inside it.
+    auto measure = [&]() {
+      std::size_t n = 0;
+      double excess = 0;
+      for (auto v : patch)
+        for (auto w : mesh_.vv_range(v)) {
+          if (in[w.idx()] && w.idx() < v.idx()) continue;  // count inner edges once
+          const double d = outside_by((mesh_.point(w) - mesh_.point(v)).norm());
+          if (d > 0) ++n, excess += d * d;
+        }
+      return std::pair<std::size_t, double>{n, excess};
+    };
+    const auto [n_before, e_before] = measure();
+    std::vector<Vec3> saved;
+    saved.reserve(patch.size());
+    for (auto v : patch) saved.push_back(mesh_.point(v));
+    std::vector<Vec3> ring;
+    for (int sweep = 0; sweep < kPatchSweeps; ++sweep) {
+      for (auto v : patch) {
+        if (mesh_.is_boundary(v)) continue;
+        ring.clear();
+        for (auto w : mesh_.vv_range(v)) ring.push_back(mesh_.point(w));
+        const Vec3 n = normal_at(v);
+        const Vec3 p = reference_.closest_point(settle(mesh_.point(v), ring, n), n);
+        if (geom::move_is_safe(mesh_, v, p)) mesh_.point(v) = p;
+      }
+    }
+    const auto [n_after, e_after] = measure();
+    const bool better = n_after < n_before || (n_after == n_before && e_after < 0.9 * e_before);
+    if (!better)
+      for (std::size_t i = 0; i < patch.size(); ++i) mesh_.point(patch[i]) = saved[i];
+    for (auto v : patch) in[v.idx()] = 0;
+    return better;
+  }
+
+  static constexpr std::size_t kPatchRings = 2;
+  static constexpr int kPatchSweeps = 6;
+
   TriMesh& mesh_;
   const ReferenceSurface& reference_;
   double e_min_, e_max_, f_;
   ComponentSizes sizes_;
   bool collapsed_ = false;
+  std::vector<char> patch_mark_;  ///< try_relax_patch's membership flags, all zero between calls
 };
 
 }  // namespace

@@ -26,7 +26,7 @@
 namespace remesh {
 
 struct CleanupCounts {
-  std::size_t flips = 0, collapses = 0, splits = 0, relocations = 0;
+  std::size_t flips = 0, collapses = 0, splits = 0, relocations = 0, patches = 0;
   std::size_t outside_before = 0, outside_after = 0;  ///< edges outside [e_min, e_max]
 };
 
