@@ -86,6 +86,7 @@ Result equalize(TriMesh& mesh, const Params& params, const OnIteration& on_itera
 
   Result result;
   std::vector<double> inside_history;  // inside_fraction after each iteration
+  bool cleanup_started = false;        // the full cleanup, once started, runs in every iteration
   for (int i = 1; i <= params.iterations; ++i) {
     if (stop.stop_requested()) {
       result.outcome = Outcome::Cancelled;
@@ -132,9 +133,10 @@ Result equalize(TriMesh& mesh, const Params& params, const OnIteration& on_itera
     // On open meshes its boundary part runs every iteration (see interval_cleanup.h).
     if (params.cleanup && !stop.stop_requested()) {
       const bool last = i == params.iterations;
-      const bool full = last || (!params.run_all_iterations &&
-                                 (2 * i > params.iterations || plateaued(inside_history) ||
-                                  inside_fraction(mesh, params, threads) >= kCleanupFrom));
+      cleanup_started = cleanup_started || (!params.run_all_iterations &&
+                                            (2 * i > params.iterations || plateaued(inside_history) ||
+                                             inside_fraction(mesh, params, threads) >= kCleanupFrom));
+      const bool full = last || cleanup_started;
       if (full || reference->has_boundary()) {
         const CleanupCounts c = interval_cleanup(mesh, *reference, params.e_min, params.e_max, params.flip_factor,
                                                  kCleanupRounds, !full);

@@ -60,7 +60,7 @@ class Cleanup {
         ++counts.splits;
       } else if (try_relocate(e)) {
         ++counts.relocations;
-      } else if (try_relax_patch(e)) {
+      } else if (patch_budget_ > 0 && (--patch_budget_, try_relax_patch(e))) {
         ++counts.patches;
       } else {
         continue;
@@ -318,6 +318,9 @@ class Cleanup {
   ComponentSizes sizes_;
   bool collapsed_ = false;
   std::vector<char> patch_mark_;  ///< try_relax_patch's membership flags, all zero between calls
+  /// Patch relaxations left in this cleanup (each costs a few hundred projections): enough for
+  /// the few stubborn edges of a nearly converged mesh, not for thousands in a rough one.
+  std::size_t patch_budget_ = std::max<std::size_t>(64, mesh_.n_edges() / 1000);
 };
 
 }  // namespace
