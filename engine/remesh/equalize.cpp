@@ -14,6 +14,7 @@
 #include "remesh/priority_list.h"
 #include "remesh/projection.h"
 #include "remesh/reference_surface.h"
+#include "remesh/regularize.h"
 #include "remesh/statistics.h"
 #include "remesh/stellar_operations.h"
 #include "remesh/valence_flips.h"
@@ -110,6 +111,11 @@ Result equalize(TriMesh& mesh, const Params& params, const OnIteration& on_itera
 
     // Algorithm 4: valence-improving flips.
     counters.flips = valence_flips(mesh, params.flip_factor, kFlipSweeps);
+    // Not in the thesis: the look-ahead flips that let 5-7 pairs cancel (regularize.h).
+    if (params.cleanup) {
+      const RegularizeCounts r = regularize(mesh, params.flip_factor);
+      counters.flips += r.single + 2 * r.pairs;
+    }
     if (stop.stop_requested()) {
       result.outcome = Outcome::Cancelled;
       break;

@@ -20,9 +20,10 @@ struct Params {
   unsigned threads = 0;       ///< 0 = all cores; results do not depend on it
   int max_iterations = 1000;  ///< upper bound for `iterations` (the service lowers it)
   std::size_t max_output_faces = 20'000'000;  ///< refuse jobs whose estimated output exceeds it; 0 = no limit
-  /// Not in the thesis: after the last iteration, fix the remaining edges outside [e_min, e_max] by
-  /// local flips, collapses, splits and vertex relocations (see interval_cleanup.h). The thesis'
-  /// conclusion asks for such a post-process; false reproduces the thesis' method alone.
+  /// Not in the thesis: (1) fix the remaining edges outside [e_min, e_max] by local flips,
+  /// collapses, splits, vertex and patch relocations (interval_cleanup.h), the post-process the
+  /// thesis' conclusion asks for; (2) after Algorithm 4, the look-ahead flips that let 5-7 pairs
+  /// cancel (regularize.h). false reproduces the thesis' method alone.
   bool cleanup = true;
 };
 

@@ -12,46 +12,18 @@ using OpenMesh::EdgeHandle;
 using OpenMesh::HalfedgeHandle;
 using OpenMesh::VertexHandle;
 
-namespace {
-
-/// The quad around interior edge e: v0 -> v1 is the edge, v2 opposite in the face of h0, v3 in the
-/// face of h1.
-struct Quad {
-  VertexHandle v0, v1, v2, v3;
-};
-
 Quad quad_of(const TriMesh& mesh, EdgeHandle e) {
   const HalfedgeHandle h0 = mesh.halfedge_handle(e, 0), h1 = mesh.halfedge_handle(e, 1);
   return {mesh.from_vertex_handle(h0), mesh.to_vertex_handle(h0),
           mesh.to_vertex_handle(mesh.next_halfedge_handle(h0)), mesh.to_vertex_handle(mesh.next_halfedge_handle(h1))};
 }
 
-/// Valence and boundary flag of every vertex, kept current through the flips of a sweep (a sweep
-/// asks for them millions of times; circulating each time dominated the step).
-struct VertexInfo {
-  std::vector<int> valence;
-  std::vector<char> boundary;
-
-  explicit VertexInfo(const TriMesh& mesh) : valence(mesh.n_vertices()), boundary(mesh.n_vertices()) {
-    for (auto v : mesh.vertices()) {
-      valence[v.idx()] = static_cast<int>(mesh.valence(v));
-      boundary[v.idx()] = mesh.is_boundary(v);
-    }
+VertexInfo::VertexInfo(const TriMesh& mesh) : valence(mesh.n_vertices()), boundary(mesh.n_vertices()) {
+  for (auto v : mesh.vertices()) {
+    valence[v.idx()] = static_cast<int>(mesh.valence(v));
+    boundary[v.idx()] = mesh.is_boundary(v);
   }
-  int deviation(VertexHandle v, int delta) const {
-    return std::abs(valence[v.idx()] + delta - (boundary[v.idx()] ? 4 : 6));
-  }
-  bool improves(const Quad& q) const {
-    const int before = deviation(q.v0, 0) + deviation(q.v1, 0) + deviation(q.v2, 0) + deviation(q.v3, 0);
-    const int after = deviation(q.v0, -1) + deviation(q.v1, -1) + deviation(q.v2, +1) + deviation(q.v3, +1);
-    return after < before;
-  }
-  void flipped(const Quad& q) {
-    --valence[q.v0.idx()], --valence[q.v1.idx()], ++valence[q.v2.idx()], ++valence[q.v3.idx()];
-  }
-};
-
-}  // namespace
+}
 
 bool flip_is_safe(const TriMesh& mesh, EdgeHandle e, double f) {
   if (mesh.status(e).deleted() || mesh.is_boundary(e) || !mesh.is_flip_ok(e)) return false;

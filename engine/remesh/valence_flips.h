@@ -10,10 +10,41 @@
 /// is the same as flipping and undoing.
 
 #include <cstddef>
+#include <cstdlib>
+#include <vector>
 
 #include "core/mesh.h"
 
 namespace remesh {
+
+/// The quad around interior edge e: v0 -> v1 is the edge, v2 opposite in the face of h0, v3 in the
+/// face of h1.
+struct Quad {
+  OpenMesh::VertexHandle v0, v1, v2, v3;
+};
+Quad quad_of(const TriMesh& mesh, OpenMesh::EdgeHandle e);
+
+/// Valence and boundary flag of every vertex, kept current through the flips of a sweep (a sweep
+/// asks for them millions of times; circulating each time dominated the step).
+struct VertexInfo {
+  std::vector<int> valence;
+  std::vector<char> boundary;
+
+  explicit VertexInfo(const TriMesh& mesh);
+  int deviation(OpenMesh::VertexHandle v, int delta) const {
+    return std::abs(valence[v.idx()] + delta - (boundary[v.idx()] ? 4 : 6));
+  }
+  /// dev_before - dev_after of flipping the quad's edge (> 0: the flip improves).
+  int gain(const Quad& q) const {
+    const int before = deviation(q.v0, 0) + deviation(q.v1, 0) + deviation(q.v2, 0) + deviation(q.v3, 0);
+    const int after = deviation(q.v0, -1) + deviation(q.v1, -1) + deviation(q.v2, +1) + deviation(q.v3, +1);
+    return before - after;
+  }
+  bool improves(const Quad& q) const { return gain(q) > 0; }
+  void flipped(const Quad& q) {
+    --valence[q.v0.idx()], --valence[q.v1.idx()], ++valence[q.v2.idx()], ++valence[q.v3.idx()];
+  }
+};
 
 /// Does edge e pass the valence-and-angle rule and the safety checks with factor f?
 bool flip_improves(const TriMesh& mesh, OpenMesh::EdgeHandle e, double f);

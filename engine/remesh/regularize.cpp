@@ -1,0 +1,78 @@
+#include "remesh/regularize.h"
+
+#include <vector>
+
+#include "remesh/valence_flips.h"
+
+namespace remesh {
+
+using OpenMesh::EdgeHandle;
+using OpenMesh::VertexHandle;
+
+namespace {
+
+class Regularizer {
+ public:
+  Regularizer(TriMesh& mesh, double f) : mesh_(mesh), info_(mesh), f_(f) {}
+
+  std::size_t sweep(RegularizeCounts& counts) {
+    std::size_t done = 0;
+    for (auto e : mesh_.edges()) {
+      if (mesh_.is_boundary(e)) continue;
+      const Quad q = quad_of(mesh_, e);
+      const int gain = info_.gain(q);
+      if (gain < 0 || !allowed(e)) continue;
+      if (gain > 0) {
+        flip(e, q);
+        ++counts.single, ++done;
+      } else if (flip_pair(e, q)) {
+        ++counts.pairs, ++done;
+      }
+    }
+    return done;
+  }
+
+ private:
+  /// Algorithm 4's safety checks and angle rule.
+  bool allowed(EdgeHandle e) const { return flip_is_safe(mesh_, e, f_); }
+
+  void flip(EdgeHandle e, const Quad& q) {
+    mesh_.flip(e);
+    info_.flipped(q);
+  }
+
+  /// Flips e (neutral), then the first edge at one of the quad's corners whose flip now lowers the
+  /// deviation; undoes the first flip when there is none.
+  bool flip_pair(EdgeHandle e, const Quad& q) {
+    flip(e, q);
+    for (VertexHandle corner : {q.v0, q.v1, q.v2, q.v3}) {
+      for (auto h : mesh_.voh_range(corner)) {
+        const EdgeHandle g = mesh_.edge_handle(h);
+        if (g == e || mesh_.is_boundary(g)) continue;
+        const Quad r = quad_of(mesh_, g);
+        if (info_.gain(r) > 0 && allowed(g)) {
+          flip(g, r);
+          return true;
+        }
+      }
+    }
+    flip(e, quad_of(mesh_, e));  // back: the edge is v2-v3 now; flipping it again restores v0-v1
+    return false;
+  }
+
+  TriMesh& mesh_;
+  VertexInfo info_;
+  double f_;
+};
+
+}  // namespace
+
+RegularizeCounts regularize(TriMesh& mesh, double f, int max_sweeps) {
+  RegularizeCounts counts;
+  Regularizer r(mesh, f);
+  for (int s = 0; s < max_sweeps; ++s)
+    if (r.sweep(counts) == 0) break;
+  return counts;
+}
+
+}  // namespace remesh
