@@ -83,6 +83,7 @@ std::string_view outcome_name(Outcome o) {
   switch (o) {
     case Outcome::Converged: return "converged";
     case Outcome::Completed: return "completed";
+    case Outcome::Stalled: return "stalled";
     case Outcome::Cancelled: return "cancelled";
   }
   return "completed";

@@ -106,6 +106,7 @@ const char* outcome_name(Outcome o) {
   switch (o) {
     case Outcome::Converged: return "converged";
     case Outcome::Cancelled: return "cancelled";
+    case Outcome::Stalled: return "stalled";
     case Outcome::Completed: break;
   }
   return "completed";

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <memory>
 #include <string>
 #include <vector>
@@ -51,6 +52,9 @@ double inside_fraction(const TriMesh& mesh, const Params& params, unsigned threa
 /// (Table 4.2 setup): the main phase alone sits at 95-96 % from iteration 20 on, splitting and
 /// collapsing hundreds of edges around the sharp features every iteration.
 constexpr int kPlateauSpan = 3;
+/// Iterations without a new low of edges outside the interval (cleanup on) before a run stops as
+/// stalled.
+constexpr int kStallSpan = 10;
 constexpr double kPlateauGain = 0.002;
 bool plateaued(const std::vector<double>& history) {
   const std::size_t n = history.size();
@@ -88,6 +92,8 @@ Result equalize(TriMesh& mesh, const Params& params, const OnIteration& on_itera
   Result result;
   std::vector<double> inside_history;  // inside_fraction after each iteration
   bool cleanup_started = false;        // the full cleanup, once started, runs in every iteration
+  std::size_t best_outside = SIZE_MAX;  // fewest edges outside the interval since then, and when
+  int best_at = 0;
   for (int i = 1; i <= params.iterations; ++i) {
     if (stop.stop_requested()) {
       result.outcome = Outcome::Cancelled;
@@ -133,9 +139,10 @@ Result equalize(TriMesh& mesh, const Params& params, const OnIteration& on_itera
     undo_folds(mesh, before, threads);
 
     // Not in the thesis: the post-process its conclusion asks for (interval_cleanup.h). It runs in
-    // the last iteration, and in every iteration once at least kCleanupFrom of the edges are inside
-    // or half the iterations are done, so that a run reaches every edge inside and stops early
-    // (convergence) instead of wandering around 99.6 % (or, when simplifying, around 88 %).
+    // the last iteration, and in every iteration once at least kCleanupFrom of the edges are inside,
+    // the main phase has plateaued or half the iterations are done, so that a run reaches every edge
+    // inside and stops early (convergence) instead of wandering around 99.6 % (or, when
+    // simplifying, around 88 %).
     // On open meshes its boundary part runs every iteration (see interval_cleanup.h).
     if (params.cleanup && !stop.stop_requested()) {
       const bool last = i == params.iterations;
@@ -166,6 +173,14 @@ Result equalize(TriMesh& mesh, const Params& params, const OnIteration& on_itera
     if (on_iteration) on_iteration(row);
     if (!params.run_all_iterations && row.small == 0 && row.big == 0) {
       result.outcome = Outcome::Converged;
+      break;
+    }
+    // Stalled: with the cleanup on, the count of edges outside has not reached a new low for
+    // kStallSpan iterations (a few edges pinned by the input's geometry, e.g. where two sheets
+    // touch): more iterations would change nothing but the time spent.
+    if (cleanup_started && row.small + row.big < best_outside) best_outside = row.small + row.big, best_at = i;
+    if (!params.run_all_iterations && cleanup_started && i - best_at >= kStallSpan) {
+      result.outcome = Outcome::Stalled;
       break;
     }
   }

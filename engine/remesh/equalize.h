@@ -41,7 +41,10 @@ struct IterationStats {
 
 using OnIteration = std::function<void(const IterationStats&)>;
 
-enum class Outcome { Completed, Converged, Cancelled };
+/// Completed: ran all iterations. Converged: stopped early with every edge inside [e_min, e_max].
+/// Stalled: stopped early because the count of edges outside stopped falling (see equalize.cpp).
+/// Cancelled: the stop token was triggered. Only Completed happens with run_all_iterations.
+enum class Outcome { Completed, Converged, Stalled, Cancelled };
 
 struct Result {
   Outcome outcome = Outcome::Completed;

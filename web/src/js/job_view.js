@@ -180,7 +180,7 @@ export class JobView {
     bar.max = Math.max(total, 1);
     bar.value = job.state === 'succeeded' ? bar.max : Math.min(done, bar.max);
     let text = `iteration ${done} of ${total}`;
-    if (job.state === 'succeeded' && done < total) text += ' (converged early)';
+    if (job.state === 'succeeded' && done < total) text += ' (stopped early)';
     if (job.outcome) text += ` · ${typeof job.outcome === 'string' ? job.outcome : JSON.stringify(job.outcome)}`;
     const secs = this.rows.reduce((s, r) => s + (r.seconds || 0), 0);
     if (secs) text += ` · ${secs.toFixed(1)} s`;
