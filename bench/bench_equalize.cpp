@@ -130,7 +130,13 @@ void print_row(const IterationStats& s) {
 }
 
 const char* outcome_name(Outcome o) {
-  return o == Outcome::Converged ? "converged" : o == Outcome::Cancelled ? "cancelled" : "completed";
+  switch (o) {
+    case Outcome::Converged: return "converged";
+    case Outcome::Stalled: return "stalled";
+    case Outcome::Cancelled: return "cancelled";
+    case Outcome::Completed: break;
+  }
+  return "completed";
 }
 
 /// The quality row printed for each remesher.
