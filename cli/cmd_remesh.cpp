@@ -29,7 +29,7 @@ const std::vector<OptionSpec> kSpec = {
     {"rings", "K", "rings k of the low-pass filter, 1..4 (default 2)"},
     {"relax-every", "PR", "replace the reference surface every PR iterations; 0 = never (default 0)"},
     {"flip-factor", "F", "a flip may lower the min angle to F times its old value, 0..1 (default 0.5)"},
-    {"all-iterations", "", "run all N iterations instead of stopping once every edge is inside"},
+    {"all-iterations", "", "run all N iterations instead of stopping early (converged or stalled)"},
     {"dual", "DUAL_OUT", "also write the trivalent dual of the result, projected onto IN"},
     {"stats", "FILE", "write the per-iteration statistics to FILE.csv or FILE.json"},
     {"threads", "T", "worker threads; 0 = all cores (default 0; results do not depend on it)"},
