@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "core/errors.h"
+#include "remesh/feature_snap.h"
 #include "remesh/fold_guard.h"
 #include "remesh/interval_cleanup.h"
 #include "remesh/low_pass_filter.h"
@@ -88,6 +89,7 @@ Result equalize(TriMesh& mesh, const Params& params, const OnIteration& on_itera
   const double sigma = 0.5 * (params.e_max - params.e_min);
   mesh.garbage_collection();
   auto reference = std::make_unique<ReferenceSurface>(mesh);
+  auto features = std::make_unique<FeatureSnap>(mesh);
 
   Result result;
   std::vector<double> inside_history;  // inside_fraction after each iteration
@@ -101,7 +103,10 @@ Result equalize(TriMesh& mesh, const Params& params, const OnIteration& on_itera
     }
     const auto iteration_start = Clock::now();
     IterationStats counters;
-    if (params.relax_every > 0 && i % params.relax_every == 0) reference = std::make_unique<ReferenceSurface>(mesh);
+    if (params.relax_every > 0 && i % params.relax_every == 0) {
+      reference = std::make_unique<ReferenceSurface>(mesh);
+      features = std::make_unique<FeatureSnap>(mesh);
+    }
 
     // Algorithms 2 and 3: stellar operations on the priority list.
     const double m_i = std::min(2.0 * mean_edge_length(mesh, threads), m);
@@ -161,6 +166,27 @@ Result equalize(TriMesh& mesh, const Params& params, const OnIteration& on_itera
     }
 
     IterationStats row = measure(mesh, params.e_min, params.e_max, threads);
+    // Is this the last iteration? Converged: every edge inside. Stalled: with the cleanup on, the
+    // count of edges outside has not reached a new low for kStallSpan iterations (a few edges
+    // pinned by the input's geometry, e.g. where two sheets touch): more iterations would change
+    // nothing but the time spent.
+    Outcome outcome = Outcome::Completed;
+    if (cleanup_started && row.small + row.big < best_outside) best_outside = row.small + row.big, best_at = i;
+    if (!params.run_all_iterations && row.small == 0 && row.big == 0) {
+      outcome = Outcome::Converged;
+    } else if (!params.run_all_iterations && cleanup_started && i - best_at >= kStallSpan) {
+      outcome = Outcome::Stalled;
+    }
+    const bool ending = outcome != Outcome::Completed || i == params.iterations;
+    // Not in the thesis: before the mesh is returned, tips and creases of the reference are put
+    // back on it (feature_snap.h); no edge leaves the interval.
+    if (ending && params.cleanup && !stop.stop_requested()) {
+      const std::size_t snapped = features->apply(mesh, *reference, params.e_min, params.e_max, threads);
+      if (snapped > 0) {
+        counters.cleanup_fixes += snapped;
+        row = measure(mesh, params.e_min, params.e_max, threads);
+      }
+    }
     row.iteration = i;
     row.splits = counters.splits;
     row.collapses = counters.collapses;
@@ -171,16 +197,8 @@ Result equalize(TriMesh& mesh, const Params& params, const OnIteration& on_itera
     result.iterations_done = i;
     inside_history.push_back(row.inside_fraction);
     if (on_iteration) on_iteration(row);
-    if (!params.run_all_iterations && row.small == 0 && row.big == 0) {
-      result.outcome = Outcome::Converged;
-      break;
-    }
-    // Stalled: with the cleanup on, the count of edges outside has not reached a new low for
-    // kStallSpan iterations (a few edges pinned by the input's geometry, e.g. where two sheets
-    // touch): more iterations would change nothing but the time spent.
-    if (cleanup_started && row.small + row.big < best_outside) best_outside = row.small + row.big, best_at = i;
-    if (!params.run_all_iterations && cleanup_started && i - best_at >= kStallSpan) {
-      result.outcome = Outcome::Stalled;
+    if (outcome != Outcome::Completed) {
+      result.outcome = outcome;
       break;
     }
   }

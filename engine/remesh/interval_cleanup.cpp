@@ -263,7 +263,15 @@ class Cleanup {
   /// would be short, nor fixed by moving one end, whose other edges are at their limits.)
   bool try_relax_patch(EdgeHandle e) {
     const HalfedgeHandle h = mesh_.halfedge_handle(e, 0);
-    std::vector<VertexHandle> patch{mesh_.from_vertex_handle(h), mesh_.to_vertex_handle(h)};
+    return relax_patch({mesh_.from_vertex_handle(h), mesh_.to_vertex_handle(h)}, VertexHandle(), Vec3(0, 0, 0),
+                       false);
+  }
+
+  /// Moves `pinned` (if valid) to `pin_at`, then relaxes the other interior vertices within
+  /// kPatchRings rings of `seeds` (which include `pinned`). Keeps the result if the patch's edges
+  /// outside the interval are fewer, or as many with 10 % less squared excess, or (with
+  /// `allow_equal`) not more; else every vertex goes back.
+  bool relax_patch(std::vector<VertexHandle> patch, VertexHandle pinned, const Vec3& pin_at, bool allow_equal) {
     std::vector<char>& in = patch_mark_;
     if (in.size() < mesh_.n_vertices()) in.assign(mesh_.n_vertices(), 0);
     for (auto v : patch) in[v.idx()] = 1;
@@ -290,10 +298,12 @@ class Cleanup {
     std::vector<Vec3> saved;
     saved.reserve(patch.size());
     for (auto v : patch) saved.push_back(mesh_.point(v));
+    bool ok = !pinned.is_valid() || geom::move_is_safe(mesh_, pinned, pin_at);
+    if (ok && pinned.is_valid()) mesh_.point(pinned) = pin_at;
     std::vector<Vec3> ring;
-    for (int sweep = 0; sweep < kPatchSweeps; ++sweep) {
+    for (int sweep = 0; ok && sweep < kPatchSweeps; ++sweep) {
       for (auto v : patch) {
-        if (mesh_.is_boundary(v)) continue;
+        if (v == pinned || mesh_.is_boundary(v)) continue;
         ring.clear();
         for (auto w : mesh_.vv_range(v)) ring.push_back(mesh_.point(w));
         const Vec3 n = normal_at(v);
@@ -301,14 +311,24 @@ class Cleanup {
         if (geom::move_is_safe(mesh_, v, p)) mesh_.point(v) = p;
       }
     }
-    const auto [n_after, e_after] = measure();
-    const bool better = n_after < n_before || (n_after == n_before && e_after < 0.9 * e_before);
-    if (!better)
+    if (ok) {
+      const auto [n_after, e_after] = measure();
+      ok = n_after < n_before || (n_after == n_before && (allow_equal || e_after < 0.9 * e_before));
+    }
+    if (!ok)
       for (std::size_t i = 0; i < patch.size(); ++i) mesh_.point(patch[i]) = saved[i];
     for (auto v : patch) in[v.idx()] = 0;
-    return better;
+    return ok;
   }
 
+ public:
+  /// See snap_to_features() in interval_cleanup.h.
+  bool snap(VertexHandle v, const Vec3& target) {
+    if (mesh_.is_boundary(v)) return false;
+    return relax_patch({v}, v, target, true);
+  }
+
+ private:
   static constexpr std::size_t kPatchRings = 2;
   static constexpr int kPatchSweeps = 6;
 
@@ -324,6 +344,15 @@ class Cleanup {
 };
 
 }  // namespace
+
+std::size_t snap_to_features(TriMesh& mesh, const ReferenceSurface& reference, double e_min, double e_max,
+                             const std::vector<std::pair<OpenMesh::VertexHandle, Vec3>>& moves) {
+  Cleanup cleanup(mesh, reference, e_min, e_max, 0.5);
+  std::size_t moved = 0;
+  for (const auto& [v, target] : moves)
+    if (cleanup.snap(v, target)) ++moved;
+  return moved;
+}
 
 CleanupCounts interval_cleanup(TriMesh& mesh, const ReferenceSurface& reference, double e_min, double e_max,
                                double flip_factor, int rounds, bool boundary_only) {

@@ -19,6 +19,8 @@
 /// inside it does nothing (idempotent).
 
 #include <cstddef>
+#include <utility>
+#include <vector>
 
 #include "core/mesh.h"
 #include "remesh/reference_surface.h"
@@ -37,5 +39,12 @@ struct CleanupCounts {
 /// split/collapse alone cannot even out a boundary whose edges are, say, 1.1 m long).
 CleanupCounts interval_cleanup(TriMesh& mesh, const ReferenceSurface& reference, double e_min, double e_max,
                                double flip_factor, int rounds = 4, bool boundary_only = false);
+
+/// Moves each listed vertex onto its target point (a point of the reference) and relaxes the
+/// interior vertices within 2 rings of it around the pinned vertex, as the patch relaxation does;
+/// keeps a move only if it folds nothing and leaves no more edges of the patch outside
+/// [e_min, e_max] than before. Returns the number of moves kept. Used by feature_snap.h.
+std::size_t snap_to_features(TriMesh& mesh, const ReferenceSurface& reference, double e_min, double e_max,
+                             const std::vector<std::pair<OpenMesh::VertexHandle, Vec3>>& moves);
 
 }  // namespace remesh

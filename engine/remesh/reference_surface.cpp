@@ -133,6 +133,14 @@ std::size_t ReferenceSurface::n_vertices() const { return impl_->points.size(); 
 std::size_t ReferenceSurface::n_triangles() const { return impl_->triangles.size(); }
 bool ReferenceSurface::has_boundary() const { return impl_->boundary_edges > 0; }
 
+std::size_t ReferenceSurface::nearest_vertices(const Vec3& p, std::size_t k, std::uint32_t* out) const {
+  const Impl& m = *impl_;
+  k = std::min({k, Impl::kMaxK, m.points.size()});
+  double dist2[Impl::kMaxK];
+  const double q[3] = {p[0], p[1], p[2]};
+  return m.tree->knnSearch(q, k, out, dist2);
+}
+
 Vec3 ReferenceSurface::closest_point(const Vec3& p, const Vec3& normal_hint) const {
   const Impl& m = *impl_;
   std::uint32_t idx[Impl::kMaxK];

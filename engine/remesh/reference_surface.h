@@ -7,6 +7,7 @@
 /// Queries are const and safe from several threads.
 
 #include <cstddef>
+#include <cstdint>
 #include <memory>
 
 #include "core/mesh.h"
@@ -26,6 +27,11 @@ class ReferenceSurface {
   /// Closest point to `p` on the boundary curves of the reference (the boundary edges incident to
   /// the nearest reference vertices). Falls back to closest_point(p) when none is near.
   Vec3 closest_boundary_point(const Vec3& p) const;
+
+  /// Indices of the (at most k, at most 64) reference vertices nearest to p, nearest first. An index
+  /// is the vertex's rank among the live vertices of the mesh it was built from, i.e. its idx() when
+  /// that mesh had no deleted vertices.
+  std::size_t nearest_vertices(const Vec3& p, std::size_t k, std::uint32_t* out) const;
 
   /// True when the reference has at least one boundary edge.
   bool has_boundary() const;

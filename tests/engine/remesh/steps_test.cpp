@@ -5,6 +5,7 @@
 #include <random>
 
 #include "remesh/geometry.h"
+#include "remesh/feature_snap.h"
 #include "remesh/interval_cleanup.h"
 #include "remesh/low_pass_filter.h"
 #include "remesh/projection.h"
@@ -306,4 +307,37 @@ TEST_CASE("the interval cleanup is safe, keeps vertices on the reference and is 
   const CleanupCounts none = interval_cleanup(inside, unit, 0.01, 100.0, 0.5);
   CHECK(none.flips + none.collapses + none.splits + none.relocations == 0);
   for (auto v : inside.vertices()) CHECK(inside.point(v) == copy.point(v));
+}
+
+TEST_CASE("feature snap puts a cut tip back on the mesh without taking edges out of the interval", "[steps]") {
+  // Reference: a grid with its centre lifted into a tip. Mesh: the same grid, flat (the tip cut).
+  TriMesh reference = test::make_open_grid(8, 8, 1.5);
+  TriMesh mesh = reference;
+  OpenMesh::VertexHandle centre;
+  double best = 1e9;
+  const Vec3 middle(6.0, 6.0, 0.0);
+  for (auto v : reference.vertices())
+    if ((reference.point(v) - middle).norm() < best) best = (reference.point(v) - middle).norm(), centre = v;
+  reference.point(centre)[2] += 0.8;
+  const Vec3 tip = reference.point(centre);
+  auto outside = [](const TriMesh& m) {
+    std::size_t n = 0;
+    for (auto e : m.edges())
+      if (m.calc_edge_length(e) < 1.2 || m.calc_edge_length(e) > 1.8) ++n;
+    return n;
+  };
+  const std::size_t outside_before = outside(mesh);
+  const FeatureSnap features(reference);
+  REQUIRE(features.size() >= 1);
+  const ReferenceSurface surface(reference);
+  CHECK(features.apply(mesh, surface, 1.2, 1.8, 2) >= 1);
+  double gap = 1e9;
+  for (auto v : mesh.vertices()) gap = std::min(gap, (mesh.point(v) - tip).norm());
+  CHECK(gap < 1e-9);
+  CHECK(outside(mesh) <= outside_before);
+  CHECK(test::check_mesh_valid(mesh) == "");
+  // Every vertex lies on the reference.
+  for (auto v : mesh.vertices()) CHECK((surface.closest_point(mesh.point(v)) - mesh.point(v)).norm() < 1e-9);
+  // A second pass finds nothing far any more.
+  CHECK(features.apply(mesh, surface, 1.2, 1.8, 2) == 0);
 }
