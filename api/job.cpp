@@ -79,15 +79,7 @@ std::string iso8601(double unix_seconds) {
   return buf;
 }
 
-std::string_view outcome_name(Outcome o) {
-  switch (o) {
-    case Outcome::Converged: return "converged";
-    case Outcome::Completed: return "completed";
-    case Outcome::Stalled: return "stalled";
-    case Outcome::Cancelled: return "cancelled";
-  }
-  return "completed";
-}
+std::string_view outcome_name(Outcome o) { return remesh::outcome_name(o); }
 
 const std::vector<std::string>& remeshed_formats() {
   static const std::vector<std::string> f = {"obj", "glb", "ply", "off", "stl"};

@@ -57,7 +57,7 @@ nlohmann::json job_to_json(const JobRecord& job, std::string_view prefix, double
 /// std::runtime_error naming the bad field.
 JobRecord job_from_json(const nlohmann::json& j);
 
-/// "converged", "completed" or "cancelled".
+/// "converged", "completed", "stalled" or "cancelled" (remesh::outcome_name).
 std::string_view outcome_name(Outcome o);
 
 /// Result kinds and the formats each can be downloaded in.

@@ -129,16 +129,6 @@ void print_row(const IterationStats& s) {
   std::fflush(stdout);
 }
 
-const char* outcome_name(Outcome o) {
-  switch (o) {
-    case Outcome::Converged: return "converged";
-    case Outcome::Stalled: return "stalled";
-    case Outcome::Cancelled: return "cancelled";
-    case Outcome::Completed: break;
-  }
-  return "completed";
-}
-
 /// The quality row printed for each remesher.
 void print_quality(const char* who, const TriMesh& input, const TriMesh& output, const bench::Topology& topo_in,
                    const ChildResult& r, const Options& o) {

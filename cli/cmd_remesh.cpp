@@ -102,16 +102,6 @@ void write_text_file(const std::string& path, const std::string& text) {
   if (!f.flush()) throw std::runtime_error("write failed: " + path);
 }
 
-const char* outcome_name(Outcome o) {
-  switch (o) {
-    case Outcome::Converged: return "converged";
-    case Outcome::Cancelled: return "cancelled";
-    case Outcome::Stalled: return "stalled";
-    case Outcome::Completed: break;
-  }
-  return "completed";
-}
-
 void print_final(const TriMesh& mesh, const Job& job, const Result& result) {
   const IterationStats q = measure(mesh, job.params.e_min, job.params.e_max, job.params.threads);
   const MeshSummary s = summarize(mesh);

@@ -54,19 +54,33 @@ double inside_fraction(const TriMesh& mesh, const Params& params, unsigned threa
 /// (Table 4.2 setup): the main phase alone sits at 95-96 % from iteration 20 on, splitting and
 /// collapsing hundreds of edges around the sharp features every iteration.
 constexpr int kPlateauSpan = 3;
+constexpr double kPlateauGain = 0.002;
+bool plateaued(const std::vector<double>& history) {
+  const std::size_t n = history.size();
+  return n > kPlateauSpan && history[n - 1] - history[n - 1 - kPlateauSpan] < kPlateauGain;
+}
+
 /// Iterations without a new low of edges outside the interval (cleanup on) before a run stops as
 /// stalled.
 constexpr int kStallSpan = 10;
+
 /// Iterations run after the first one with every edge inside, and the further iterations allowed
 /// for the interval to be whole again. Measured (Table 4.2 setup): regular vertices eight
 /// 87.3 -> 89.4 %, spot 88.0 -> 88.9 %, kitten 88.9 -> 89.3 % (one more iteration; spot needs three
 /// to have every edge inside again).
 constexpr int kPolishIterations = 1;
 constexpr int kPolishGrace = 3;
-constexpr double kPlateauGain = 0.002;
-bool plateaued(const std::vector<double>& history) {
-  const std::size_t n = history.size();
-  return n > kPlateauSpan && history[n - 1] - history[n - 1 - kPlateauSpan] < kPlateauGain;
+
+/// The statistics of `mesh` with the iteration number and operation counters of `counted`.
+IterationStats measured_row(const TriMesh& mesh, const Params& params, const IterationStats& counted) {
+  IterationStats row = measure(mesh, params.e_min, params.e_max, params.threads);
+  row.iteration = counted.iteration;
+  row.splits = counted.splits;
+  row.collapses = counted.collapses;
+  row.flips = counted.flips;
+  row.cleanup_fixes = counted.cleanup_fixes;
+  row.max_projection_distance = counted.max_projection_distance;
+  return row;
 }
 
 void check_preconditions(const TriMesh& mesh, const Params& params) {
@@ -79,6 +93,16 @@ void check_preconditions(const TriMesh& mesh, const Params& params) {
 }
 
 }  // namespace
+
+const char* outcome_name(Outcome o) {
+  switch (o) {
+    case Outcome::Converged: return "converged";
+    case Outcome::Stalled: return "stalled";
+    case Outcome::Cancelled: return "cancelled";
+    case Outcome::Completed: break;
+  }
+  return "completed";
+}
 
 std::size_t estimate_output_faces(const TriMesh& mesh, const Params& params) {
   const double m = 0.5 * (params.e_min + params.e_max);
@@ -184,13 +208,8 @@ Result equalize(TriMesh& mesh, const Params& params, const OnIteration& on_itera
       }
     }
 
-    IterationStats row = measure(mesh, params.e_min, params.e_max, threads);
-    row.iteration = i;
-    row.splits = counters.splits;
-    row.collapses = counters.collapses;
-    row.flips = counters.flips;
-    row.cleanup_fixes = counters.cleanup_fixes;
-    row.max_projection_distance = counters.max_projection_distance;
+    counters.iteration = i;
+    IterationStats row = measured_row(mesh, params, counters);
     // Is this the last iteration? Converged: every edge inside; with the cleanup on, after
     // kPolishIterations more iterations that raise regularity (if they lose the interval and do not
     // win it back within kPolishGrace, the mesh of the first convergence is returned). Stalled:
@@ -228,14 +247,8 @@ Result equalize(TriMesh& mesh, const Params& params, const OnIteration& on_itera
     if (ending && params.cleanup && !stop.stop_requested()) {
       const std::size_t snapped = features->apply(mesh, *reference, params.e_min, params.e_max, threads);
       if (snapped > 0) {
-        const IterationStats counted = row;
-        row = measure(mesh, params.e_min, params.e_max, threads);
-        row.iteration = counted.iteration;
-        row.splits = counted.splits;
-        row.collapses = counted.collapses;
-        row.flips = counted.flips;
-        row.cleanup_fixes = counted.cleanup_fixes + snapped;
-        row.max_projection_distance = counted.max_projection_distance;
+        row.cleanup_fixes += snapped;
+        row = measured_row(mesh, params, row);
       }
     }
     row.seconds = restore ? first->row.seconds : seconds_since(iteration_start);

@@ -46,6 +46,9 @@ using OnIteration = std::function<void(const IterationStats&)>;
 /// Cancelled: the stop token was triggered. Only Completed happens with run_all_iterations.
 enum class Outcome { Completed, Converged, Stalled, Cancelled };
 
+/// "completed", "converged", "stalled" or "cancelled" (the API, CLI and benchmark print these).
+const char* outcome_name(Outcome o);
+
 struct Result {
   Outcome outcome = Outcome::Completed;
   int iterations_done = 0;

@@ -13,20 +13,6 @@ namespace remesh {
 
 namespace {
 
-/// 2 pi minus the sum of the angles at v (0 for a boundary vertex).
-double angle_deficit(const TriMesh& mesh, OpenMesh::VertexHandle v) {
-  double angles = 0;
-  for (auto h : mesh.voh_range(v)) {
-    if (mesh.is_boundary(h)) return 0;
-    const Vec3 a = mesh.point(mesh.to_vertex_handle(h)) - mesh.point(v);
-    const Vec3 b = mesh.point(mesh.to_vertex_handle(mesh.next_halfedge_handle(h))) - mesh.point(v);
-    const double na = a.norm(), nb = b.norm();
-    if (!(na > 0) || !(nb > 0)) return 0;
-    angles += std::acos(std::clamp((a | b) / (na * nb), -1.0, 1.0));
-  }
-  return 2 * M_PI - angles;
-}
-
 bool on_crease(const TriMesh& mesh, OpenMesh::VertexHandle v) {
   for (auto h : mesh.voh_range(v)) {
     const auto f = mesh.face_handle(h), g = mesh.opposite_face_handle(h);
@@ -43,7 +29,7 @@ bool on_crease(const TriMesh& mesh, OpenMesh::VertexHandle v) {
 FeatureSnap::FeatureSnap(const TriMesh& reference) {
   for (auto v : reference.vertices()) {
     if (reference.status(v).deleted() || reference.is_isolated(v) || reference.is_boundary(v)) continue;
-    if (std::abs(angle_deficit(reference, v)) > kTipDeficit || on_crease(reference, v))
+    if (std::abs(geom::angle_deficit(reference, v)) > kTipDeficit || on_crease(reference, v))
       points_.push_back(reference.point(v));
   }
 }

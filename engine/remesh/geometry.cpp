@@ -117,6 +117,19 @@ Vec3 moved_normal(const TriMesh& mesh, OpenMesh::FaceHandle f, OpenMesh::VertexH
 }
 }  // namespace
 
+double angle_deficit(const TriMesh& mesh, OpenMesh::VertexHandle v) {
+  double angles = 0;
+  for (auto h : mesh.voh_range(v)) {
+    if (mesh.is_boundary(h)) return 0;
+    const Vec3 a = mesh.point(mesh.to_vertex_handle(h)) - mesh.point(v);
+    const Vec3 b = mesh.point(mesh.to_vertex_handle(mesh.next_halfedge_handle(h))) - mesh.point(v);
+    const double na = a.norm(), nb = b.norm();
+    if (!(na > 0) || !(nb > 0)) return 0;
+    angles += std::acos(std::clamp((a | b) / (na * nb), -1.0, 1.0));
+  }
+  return 2 * M_PI - angles;
+}
+
 bool move_is_safe(const TriMesh& mesh, OpenMesh::VertexHandle v, const Vec3& p) {
   const double floor_angle = std::min(kMinAngle, star_min_angle(mesh, v));
   // No fold between a face of the star and any of its neighbours.

@@ -50,6 +50,10 @@ Vec3 face_normal(const TriMesh& mesh, OpenMesh::FaceHandle f);
 /// Area-weighted unit vertex normals, one per vertex index (zero for isolated vertices). Parallel.
 std::vector<Vec3> vertex_normals(const TriMesh& mesh, unsigned threads);
 
+/// 2 pi minus the sum of the angles at interior vertex v (radians; positive at a tip, negative at
+/// a saddle); 0 for a boundary vertex or a star with a zero-length edge.
+double angle_deficit(const TriMesh& mesh, OpenMesh::VertexHandle v);
+
 /// Smallest angle (radians) of the faces around v (the worst angle of its star).
 double star_min_angle(const TriMesh& mesh, OpenMesh::VertexHandle v);
 

@@ -57,16 +57,7 @@ Vec3 ring_centroid(const TriMesh& mesh, OpenMesh::VertexHandle v, int rings) {
 }  // namespace
 
 bool is_corner(const TriMesh& mesh, OpenMesh::VertexHandle v) {
-  double angles = 0;
-  for (auto h : mesh.voh_range(v)) {
-    if (mesh.is_boundary(h)) return false;
-    const Vec3 a = mesh.point(mesh.to_vertex_handle(h)) - mesh.point(v);
-    const Vec3 b = mesh.point(mesh.to_vertex_handle(mesh.next_halfedge_handle(h))) - mesh.point(v);
-    const double na = a.norm(), nb = b.norm();
-    if (!(na > 0) || !(nb > 0)) return false;
-    angles += std::acos(std::clamp((a | b) / (na * nb), -1.0, 1.0));
-  }
-  return std::abs(2 * M_PI - angles) > kCornerDeficit;
+  return std::abs(geom::angle_deficit(mesh, v)) > kCornerDeficit;
 }
 
 std::vector<Vec3> low_pass_displacements(const TriMesh& mesh, int rings, unsigned threads) {

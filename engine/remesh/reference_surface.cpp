@@ -49,10 +49,10 @@ struct ReferenceSurface::Impl {
   std::unique_ptr<KdTree> tree;
 
   static constexpr std::size_t kMaxK = 64;
-  /// The min(neighbours, kMaxK) reference vertices nearest to p, nearest first, into idx.
-  std::size_t nearest(const Vec3& p, std::uint32_t (&idx)[kMaxK]) const {
+  /// The min(k, kMaxK) reference vertices nearest to p, nearest first, into idx.
+  std::size_t nearest(const Vec3& p, std::uint32_t* idx, std::size_t k) const {
     double dist2[kMaxK];
-    const std::size_t k = std::min({neighbours, kMaxK, points.size()});
+    k = std::min({k, kMaxK, points.size()});
     const double q[3] = {p[0], p[1], p[2]};
     return tree->knnSearch(q, k, idx, dist2);
   }
@@ -134,17 +134,13 @@ std::size_t ReferenceSurface::n_triangles() const { return impl_->triangles.size
 bool ReferenceSurface::has_boundary() const { return impl_->boundary_edges > 0; }
 
 std::size_t ReferenceSurface::nearest_vertices(const Vec3& p, std::size_t k, std::uint32_t* out) const {
-  const Impl& m = *impl_;
-  k = std::min({k, Impl::kMaxK, m.points.size()});
-  double dist2[Impl::kMaxK];
-  const double q[3] = {p[0], p[1], p[2]};
-  return m.tree->knnSearch(q, k, out, dist2);
+  return impl_->nearest(p, out, k);
 }
 
 Vec3 ReferenceSurface::closest_point(const Vec3& p, const Vec3& normal_hint) const {
   const Impl& m = *impl_;
   std::uint32_t idx[Impl::kMaxK];
-  const std::size_t found = m.nearest(p, idx);
+  const std::size_t found = m.nearest(p, idx, m.neighbours);
 
   // Best candidate overall and best candidate whose normal agrees with the hint. The agreeing one
   // wins when it is nearly as close (two sheets close together: stay on the vertex's own sheet).
@@ -183,7 +179,7 @@ Vec3 ReferenceSurface::closest_boundary_point(const Vec3& p) const {
   const Impl& m = *impl_;
   if (m.boundary_edges == 0) return closest_point(p);
   std::uint32_t idx[Impl::kMaxK];
-  const std::size_t found = m.nearest(p, idx);
+  const std::size_t found = m.nearest(p, idx, m.neighbours);
   Vec3 best(0, 0, 0);
   double best_d2 = std::numeric_limits<double>::max();
   for (std::size_t i = 0; i < found; ++i) {
