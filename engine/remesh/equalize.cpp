@@ -121,6 +121,7 @@ Result equalize(TriMesh& mesh, const Params& params, const OnIteration& on_itera
   mesh.garbage_collection();
   auto reference = std::make_unique<ReferenceSurface>(mesh);
   auto features = std::make_unique<FeatureSnap>(mesh);
+  std::vector<NeighbourCache> neighbour_caches;  // per vertex, for the projection (projection.h)
 
   Result result;
   std::vector<double> inside_history;  // inside_fraction after each iteration
@@ -183,7 +184,7 @@ Result equalize(TriMesh& mesh, const Params& params, const OnIteration& on_itera
       result.outcome = Outcome::Cancelled;
       break;
     }
-    counters.max_projection_distance = project_onto_reference(mesh, *reference, threads);
+    counters.max_projection_distance = project_onto_reference(mesh, *reference, threads, &neighbour_caches);
     undo_folds(mesh, before, threads);
 
     // Not in the thesis: the post-process its conclusion asks for (interval_cleanup.h). It runs in

@@ -60,7 +60,7 @@ class Cleanup {
         ++counts.splits;
       } else if (try_relocate(e)) {
         ++counts.relocations;
-      } else if (patch_budget_ > 0 && (--patch_budget_, try_relax_patch(e))) {
+      } else if (patch_budget_ > 0 && !patch_failed(e) && (--patch_budget_, try_relax_patch(e))) {
         ++counts.patches;
       } else {
         continue;
@@ -71,6 +71,7 @@ class Cleanup {
       mesh_.garbage_collection();
       sizes_ = ComponentSizes(mesh_);
       collapsed_ = false;
+      failed_patches_.clear();  // edge indices changed
     }
     return fixes;
   }
@@ -263,8 +264,16 @@ class Cleanup {
   /// would be short, nor fixed by moving one end, whose other edges are at their limits.)
   bool try_relax_patch(EdgeHandle e) {
     const HalfedgeHandle h = mesh_.halfedge_handle(e, 0);
-    return relax_patch({mesh_.from_vertex_handle(h), mesh_.to_vertex_handle(h)}, VertexHandle(), Vec3(0, 0, 0),
-                       false);
+    if (relax_patch({mesh_.from_vertex_handle(h), mesh_.to_vertex_handle(h)}, VertexHandle(), Vec3(0, 0, 0), false))
+      return true;
+    failed_patches_.push_back(e.idx());
+    return false;
+  }
+
+  /// Has the patch of e already failed in this cleanup? (Retrying it in the next round costs a few
+  /// hundred projections and almost never succeeds; the next iteration's cleanup tries again.)
+  bool patch_failed(EdgeHandle e) const {
+    return std::find(failed_patches_.begin(), failed_patches_.end(), e.idx()) != failed_patches_.end();
   }
 
   /// Moves `pinned` (if valid) to `pin_at`, then relaxes the other interior vertices within
@@ -301,13 +310,16 @@ class Cleanup {
     bool ok = !pinned.is_valid() || geom::move_is_safe(mesh_, pinned, pin_at);
     if (ok && pinned.is_valid()) mesh_.point(pinned) = pin_at;
     std::vector<Vec3> ring;
+    // Each vertex moves a little per sweep: its kd-tree answer is mostly reusable (reference_surface.h).
+    patch_caches_.assign(patch.size(), NeighbourCache{});
     for (int sweep = 0; ok && sweep < kPatchSweeps; ++sweep) {
-      for (auto v : patch) {
+      for (std::size_t i = 0; i < patch.size(); ++i) {
+        const VertexHandle v = patch[i];
         if (v == pinned || mesh_.is_boundary(v)) continue;
         ring.clear();
         for (auto w : mesh_.vv_range(v)) ring.push_back(mesh_.point(w));
         const Vec3 n = normal_at(v);
-        const Vec3 p = reference_.closest_point(settle(mesh_.point(v), ring, n), n);
+        const Vec3 p = reference_.closest_point(settle(mesh_.point(v), ring, n), n, patch_caches_[i]);
         if (geom::move_is_safe(mesh_, v, p)) mesh_.point(v) = p;
       }
     }
@@ -338,6 +350,8 @@ class Cleanup {
   ComponentSizes sizes_;
   bool collapsed_ = false;
   std::vector<char> patch_mark_;  ///< try_relax_patch's membership flags, all zero between calls
+  std::vector<NeighbourCache> patch_caches_;  ///< relax_patch's kd-tree answers, one per patch vertex
+  std::vector<int> failed_patches_;           ///< edges whose patch relaxation failed (patch_failed)
   /// Patch relaxations left in this cleanup (each costs a few hundred projections): enough for
   /// the few stubborn edges of a nearly converged mesh, not for thousands in a rough one.
   std::size_t patch_budget_ = std::max<std::size_t>(64, mesh_.n_edges() / 1000);

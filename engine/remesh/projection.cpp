@@ -14,8 +14,10 @@ Vec3 project_vertex(const TriMesh& mesh, OpenMesh::VertexHandle v, const Vec3& p
   return reference.closest_point(p, normal);
 }
 
-double project_onto_reference(TriMesh& mesh, const ReferenceSurface& reference, unsigned threads) {
+double project_onto_reference(TriMesh& mesh, const ReferenceSurface& reference, unsigned threads,
+                              std::vector<NeighbourCache>* caches) {
   const std::size_t n = mesh.n_vertices();
+  if (caches && caches->size() < n) caches->resize(n);
   const std::vector<Vec3> normals = geom::vertex_normals(mesh, threads);
   std::vector<Vec3> target(n);
   constexpr std::size_t kBlock = 512;
@@ -29,7 +31,9 @@ double project_onto_reference(TriMesh& mesh, const ReferenceSurface& reference, 
         target[i] = p;
         continue;
       }
-      target[i] = project_vertex(mesh, v, p, normals[i], reference);
+      const bool interior = !(mesh.is_boundary(v) && reference.has_boundary());
+      target[i] = caches && interior ? reference.closest_point(p, normals[i], (*caches)[i])
+                                     : project_vertex(mesh, v, p, normals[i], reference);
       worst = std::max(worst, (target[i] - p).norm());
     }
     block_max[block] = worst;

@@ -6,14 +6,19 @@
 /// boundaries. Where two sheets are close, the candidate whose normal agrees with the vertex normal
 /// wins. Parallel over vertices; each vertex's result depends only on the mesh before the step.
 
+#include <vector>
+
 #include "core/mesh.h"
 #include "remesh/reference_surface.h"
 
 namespace remesh {
 
 /// Projects every live, non-isolated vertex of `mesh` onto `reference`. Returns the largest
-/// distance a vertex moved (mesh units).
-double project_onto_reference(TriMesh& mesh, const ReferenceSurface& reference, unsigned threads);
+/// distance a vertex moved (mesh units). With `caches`, interior vertex i keeps its kd-tree answer in
+/// (*caches)[i] for the next call (resized as needed). The answer stays exact whichever vertex a
+/// cache came from (reference_surface.h), so renumbering by garbage collection costs only misses.
+double project_onto_reference(TriMesh& mesh, const ReferenceSurface& reference, unsigned threads,
+                              std::vector<NeighbourCache>* caches = nullptr);
 
 /// The position one vertex would take: closest_boundary_point for boundary vertices, else
 /// closest_point with `normal` as the hint.

@@ -2,9 +2,11 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <utility>
 #include <vector>
 
 #include <nanoflann.hpp>
@@ -45,6 +47,7 @@ struct ReferenceSurface::Impl {
   Csr vertex_boundary;              ///< other end of each boundary edge at a vertex
   std::size_t boundary_edges = 0;
   std::size_t neighbours = 30;
+  std::uint64_t id = 0;  ///< unique per surface, for NeighbourCache
   PointCloud cloud;
   std::unique_ptr<KdTree> tree;
 
@@ -56,6 +59,37 @@ struct ReferenceSurface::Impl {
     const double q[3] = {p[0], p[1], p[2]};
     return tree->knnSearch(q, k, idx, dist2);
   }
+
+  /// nearest(p, idx, neighbours), answered from `cache` when that is exact (file comment of the
+  /// header), else from the kd-tree, refilling the cache.
+  std::size_t nearest(const Vec3& p, std::uint32_t* idx, NeighbourCache& cache) const {
+    const std::size_t k = std::min({neighbours, kMaxK, points.size()});
+    if (cache.surface == id && cache.count >= k) {
+      std::pair<double, std::uint32_t> by_distance[NeighbourCache::kCacheSize];
+      for (std::uint32_t i = 0; i < cache.count; ++i)
+        by_distance[i] = {(points[cache.idx[i]] - p).sqrnorm(), cache.idx[i]};
+      std::partial_sort(by_distance, by_distance + k, by_distance + cache.count);
+      const double moved = (p - cache.query).norm();
+      if (std::sqrt(by_distance[k - 1].first) + moved < cache.radius) {
+        for (std::size_t i = 0; i < k; ++i) idx[i] = by_distance[i].second;
+        return k;
+      }
+    }
+    const std::size_t size = std::min(NeighbourCache::kCacheSize, points.size());
+    double dist2[NeighbourCache::kCacheSize];
+    const double q[3] = {p[0], p[1], p[2]};
+    const std::size_t found = tree->knnSearch(q, size, cache.idx, dist2);
+    cache.surface = id;
+    cache.query = p;
+    cache.count = static_cast<std::uint32_t>(found);
+    // With every reference vertex in the cache, any point may reuse it.
+    cache.radius = found == points.size() ? std::numeric_limits<double>::infinity()
+                                          : std::sqrt(dist2[found - 1]);
+    std::copy_n(cache.idx, std::min(k, found), idx);
+    return std::min(k, found);
+  }
+
+  Vec3 closest_point(const Vec3& p, const Vec3& normal_hint, const std::uint32_t* idx, std::size_t found) const;
 };
 
 ReferenceSurface::ReferenceSurface(const TriMesh& mesh, std::size_t neighbours)
@@ -123,6 +157,8 @@ ReferenceSurface::ReferenceSurface(const TriMesh& mesh, std::size_t neighbours)
   m.cloud.points = &m.points;
   m.tree = std::make_unique<KdTree>(3, m.cloud, nanoflann::KDTreeSingleIndexAdaptorParams(16));
   m.tree->buildIndex();
+  static std::atomic<std::uint64_t> next_id{1};
+  m.id = next_id++;
 }
 
 ReferenceSurface::~ReferenceSurface() = default;
@@ -138,9 +174,21 @@ std::size_t ReferenceSurface::nearest_vertices(const Vec3& p, std::size_t k, std
 }
 
 Vec3 ReferenceSurface::closest_point(const Vec3& p, const Vec3& normal_hint) const {
-  const Impl& m = *impl_;
   std::uint32_t idx[Impl::kMaxK];
-  const std::size_t found = m.nearest(p, idx, m.neighbours);
+  const std::size_t found = impl_->nearest(p, idx, impl_->neighbours);
+  return impl_->closest_point(p, normal_hint, idx, found);
+}
+
+Vec3 ReferenceSurface::closest_point(const Vec3& p, const Vec3& normal_hint, NeighbourCache& cache) const {
+  std::uint32_t idx[Impl::kMaxK];
+  const std::size_t found = impl_->nearest(p, idx, cache);
+  return impl_->closest_point(p, normal_hint, idx, found);
+}
+
+/// The closest point to p on the triangles incident to the reference vertices idx[0..found).
+Vec3 ReferenceSurface::Impl::closest_point(const Vec3& p, const Vec3& normal_hint, const std::uint32_t* idx,
+                                           std::size_t found) const {
+  const Impl& m = *this;
 
   // Best candidate overall and best candidate whose normal agrees with the hint. The agreeing one
   // wins when it is nearly as close (two sheets close together: stay on the vertex's own sheet).

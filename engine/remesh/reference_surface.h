@@ -5,6 +5,12 @@
 /// nearest reference vertices and returns the closest point on them; where candidates are nearly as
 /// close (thin parts, two sheets), the one whose normal agrees with `normal_hint` wins.
 /// Queries are const and safe from several threads.
+///
+/// A NeighbourCache lets a caller that queries again from a nearby point (every vertex, every
+/// iteration) skip the kd-tree: the cache keeps the kCacheSize nearest vertices of the last query
+/// point q and the distance R to the farthest of them. Every other reference vertex is at least R
+/// from q, so at least R - |p - q| from a new point p; when the 30 cached vertices nearest to p are
+/// all closer than that, they are exactly the 30 nearest vertices the kd-tree would return.
 
 #include <cstddef>
 #include <cstdint>
@@ -13,6 +19,16 @@
 #include "core/mesh.h"
 
 namespace remesh {
+
+/// The last kd-tree answer for one query point (see the file comment). Zero-initialised = empty.
+struct NeighbourCache {
+  static constexpr std::size_t kCacheSize = 40;
+  Vec3 query{0, 0, 0};
+  double radius = 0;            ///< distance from query to the farthest cached vertex
+  std::uint64_t surface = 0;    ///< id of the ReferenceSurface that filled it; 0 = empty
+  std::uint32_t count = 0;
+  std::uint32_t idx[kCacheSize] = {};
+};
 
 class ReferenceSurface {
  public:
@@ -23,6 +39,9 @@ class ReferenceSurface {
 
   /// Closest point on the reference surface to `p`. `normal_hint` may be zero (no preference).
   Vec3 closest_point(const Vec3& p, const Vec3& normal_hint = Vec3(0, 0, 0)) const;
+  /// The same point, with the nearest vertices taken from `cache` when it is still exact (and the
+  /// cache refilled from the kd-tree when it is not).
+  Vec3 closest_point(const Vec3& p, const Vec3& normal_hint, NeighbourCache& cache) const;
 
   /// Closest point to `p` on the boundary curves of the reference (the boundary edges incident to
   /// the nearest reference vertices). Falls back to closest_point(p) when none is near.

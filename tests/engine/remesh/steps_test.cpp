@@ -269,6 +269,35 @@ TEST_CASE("projection lands on the reference surface", "[steps]") {
   for (auto v : mesh.vertices()) CHECK(std::abs(mesh.point(v).norm() - 1.0) < 2e-3);
 }
 
+TEST_CASE("a reused neighbour cache gives the kd-tree's closest point", "[steps]") {
+  // A bumpy torus: uneven vertex spacing, so that cached sets are often not the nearest ones.
+  TriMesh torus = test::make_torus(48, 24, 10.0, 3.0);
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> jitter(-0.3, 0.3);
+  for (auto v : torus.vertices()) torus.point(v) += Vec3(jitter(rng), jitter(rng), jitter(rng));
+  const ReferenceSurface reference(torus);
+  std::normal_distribution<double> g(0, 1);
+  std::uniform_int_distribution<int> pick(0, static_cast<int>(torus.n_vertices()) - 1);
+  std::size_t reused = 0, refilled = 0;
+  for (int walker = 0; walker < 40; ++walker) {
+    NeighbourCache cache;
+    Vec3 p = torus.point(torus.vertex_handle(pick(rng)));
+    for (int step = 0; step < 60; ++step) {
+      const double size = step % 10 == 9 ? 3.0 : 0.05;  // mostly small moves, now and then a jump
+      p += Vec3(g(rng), g(rng), g(rng)) * size;
+      const Vec3 hint(g(rng), g(rng), g(rng));
+      const Vec3 before = cache.query;
+      const Vec3 cached = reference.closest_point(p, hint, cache);
+      const Vec3 fresh = reference.closest_point(p, hint);
+      CHECK(std::abs((cached - p).norm() - (fresh - p).norm()) < 1e-12);
+      CHECK((cached - fresh).norm() < 1e-9);
+      (cache.query == p && before != p) ? ++refilled : ++reused;
+    }
+  }
+  CHECK(reused > 0);
+  CHECK(refilled > 40);  // every walker's first query, and jumps
+}
+
 TEST_CASE("the interval cleanup is safe, keeps vertices on the reference and is idempotent", "[steps]") {
   const TriMesh sphere = test::make_icosphere(5, 20.0);  // fine reference, edge ~0.7
   const ReferenceSurface reference(sphere);
