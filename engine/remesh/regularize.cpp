@@ -13,22 +13,25 @@ namespace {
 
 class Regularizer {
  public:
-  Regularizer(TriMesh& mesh, double f) : mesh_(mesh), info_(mesh), f_(f) {}
+  Regularizer(TriMesh& mesh, double f) : mesh_(mesh), info_(mesh), f_(f), marks_(mesh.n_vertices()) {}
 
   std::size_t sweep(RegularizeCounts& counts) {
     std::size_t done = 0;
     for (auto e : mesh_.edges()) {
       if (mesh_.is_boundary(e)) continue;
       const Quad q = quad_of(mesh_, e);
+      if (!marks_.any(q)) continue;
       const int gain = info_.gain(q);
       if (gain < 0 || !allowed(e)) continue;
       if (gain > 0) {
         flip(e, q);
+        touch(q);
         ++counts.single, ++done;
       } else if (flip_pair(e, q)) {
         ++counts.pairs, ++done;
       }
     }
+    marks_.next_sweep();
     return done;
   }
 
@@ -39,6 +42,15 @@ class Regularizer {
   void flip(EdgeHandle e, const Quad& q) {
     mesh_.flip(e);
     info_.flipped(q);
+  }
+
+  /// A flip that stands: its quad's vertices and their neighbours are touched. (A pair of flips
+  /// looks one ring further than a single flip: everything it reads lies in the quad's 1-ring.)
+  void touch(const Quad& q) {
+    for (auto v : {q.v0, q.v1, q.v2, q.v3}) {
+      marks_.touch(v);
+      for (auto w : mesh_.vv_range(v)) marks_.touch(w);
+    }
   }
 
   /// Flips e (neutral), then the first edge at one of the quad's corners whose flip now lowers the
@@ -52,6 +64,8 @@ class Regularizer {
         const Quad r = quad_of(mesh_, g);
         if (info_.gain(r) > 0 && allowed(g)) {
           flip(g, r);
+          touch(q);
+          touch(r);
           return true;
         }
       }
@@ -63,6 +77,7 @@ class Regularizer {
   TriMesh& mesh_;
   VertexInfo info_;
   double f_;
+  SweepMarks marks_;
 };
 
 }  // namespace

@@ -62,26 +62,42 @@ bool flip_improves(const TriMesh& mesh, EdgeHandle e, double f) {
   return VertexInfo(mesh).improves(quad_of(mesh, e)) && flip_is_safe(mesh, e, f);
 }
 
-std::size_t valence_flip_sweep(TriMesh& mesh, double f) {
+namespace {
+
+/// One sweep over the interior edges in index order; with `marks`, only those it says may have
+/// changed.
+std::size_t sweep(TriMesh& mesh, double f, VertexInfo& info, SweepMarks* marks) {
   std::size_t flips = 0;
-  VertexInfo info(mesh);
   for (auto e : mesh.edges()) {
     if (mesh.is_boundary(e)) continue;
     const Quad q = quad_of(mesh, e);
+    if (marks && !marks->any(q)) continue;
     if (!info.improves(q) || !flip_is_safe(mesh, e, f)) continue;
     mesh.flip(e);
     info.flipped(q);
+    if (marks)
+      for (auto v : {q.v0, q.v1, q.v2, q.v3}) marks->touch(v);
     ++flips;
   }
   return flips;
 }
 
+}  // namespace
+
+std::size_t valence_flip_sweep(TriMesh& mesh, double f) {
+  VertexInfo info(mesh);
+  return sweep(mesh, f, info, nullptr);
+}
+
 std::size_t valence_flips(TriMesh& mesh, double f, int max_sweeps) {
   std::size_t total = 0;
+  VertexInfo info(mesh);
+  SweepMarks marks(mesh.n_vertices());
   for (int s = 0; s < max_sweeps; ++s) {
-    const std::size_t n = valence_flip_sweep(mesh, f);
+    const std::size_t n = sweep(mesh, f, info, &marks);
     total += n;
     if (n == 0) break;
+    marks.next_sweep();
   }
   return total;
 }

@@ -9,6 +9,7 @@
 /// normals agree with both old ones) nor creates a degenerate one. We test before flipping, which
 /// is the same as flipping and undoing.
 
+#include <algorithm>
 #include <cstddef>
 #include <cstdlib>
 #include <vector>
@@ -44,6 +45,29 @@ struct VertexInfo {
   void flipped(const Quad& q) {
     --valence[q.v0.idx()], --valence[q.v1.idx()], ++valence[q.v2.idx()], ++valence[q.v3.idx()];
   }
+};
+
+/// Which edges a sweep after the first must look at again. Flips move no vertex, and a flip changes
+/// the valence of its quad's four vertices, which are the corners of every triangle it changes; so
+/// an edge whose quad has no vertex touched since the edge was last looked at would get the same
+/// answer again, and is skipped. Sweeps that skip give the same flips as full sweeps.
+class SweepMarks {
+ public:
+  explicit SweepMarks(std::size_t n_vertices) : previous_(n_vertices, 1), current_(n_vertices, 0) {}
+  /// Touched in the previous sweep or in this one so far (every vertex, in the first sweep).
+  bool any(const Quad& q) const {
+    for (auto v : {q.v0, q.v1, q.v2, q.v3})
+      if (previous_[v.idx()] | current_[v.idx()]) return true;
+    return false;
+  }
+  void touch(OpenMesh::VertexHandle v) { current_[v.idx()] = 1; }
+  void next_sweep() {
+    previous_.swap(current_);
+    std::fill(current_.begin(), current_.end(), 0);
+  }
+
+ private:
+  std::vector<char> previous_, current_;
 };
 
 /// Does edge e pass the valence-and-angle rule and the safety checks with factor f?
