@@ -135,8 +135,8 @@ Result equalize(TriMesh& mesh, const Params& params, const OnIteration& on_itera
   Result result;
   std::vector<double> inside_history;  // inside_fraction after each iteration
   bool cleanup_started = false;        // the full cleanup, once started, runs in every iteration
-  std::size_t best_outside = SIZE_MAX;  // fewest edges outside the interval since then, and when
-  int best_at = 0;
+  std::size_t fewest_outside = SIZE_MAX;  // fewest edges outside the interval since then, and when
+  int fewest_at = 0;
   // Polishing (see kPolishMax): when it began, and the best mesh so far with every edge inside.
   struct Converged {
     TriMesh mesh;
@@ -229,7 +229,7 @@ Result equalize(TriMesh& mesh, const Params& params, const OnIteration& on_itera
     const bool all_inside = row.small == 0 && row.big == 0;
     Outcome outcome = Outcome::Completed;
     bool restore = false;
-    if (cleanup_started && row.small + row.big < best_outside) best_outside = row.small + row.big, best_at = i;
+    if (cleanup_started && row.small + row.big < fewest_outside) fewest_outside = row.small + row.big, fewest_at = i;
     if (!params.run_all_iterations && params.cleanup) {
       if (all_inside && !best) {
         best = Converged{mesh, row};
@@ -247,7 +247,7 @@ Result equalize(TriMesh& mesh, const Params& params, const OnIteration& on_itera
           best = Converged{mesh, row};
           flush();  // the rows before this one stand
         }
-      } else if (i - best_at >= kStallSpan && cleanup_started) {
+      } else if (i - fewest_at >= kStallSpan && cleanup_started) {
         outcome = Outcome::Stalled;
       }
     } else if (!params.run_all_iterations && all_inside) {

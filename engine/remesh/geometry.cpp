@@ -84,14 +84,17 @@ Vec3 face_normal(const TriMesh& mesh, OpenMesh::FaceHandle f) {
   return cross_normal(mesh.point(v[0]), mesh.point(v[1]), mesh.point(v[2]));
 }
 
+Vec3 vertex_normal(const TriMesh& mesh, OpenMesh::VertexHandle v) {
+  Vec3 n(0, 0, 0);
+  for (auto f : mesh.vf_range(v)) n += face_normal(mesh, f);
+  const double len = n.norm();
+  return len > 0 ? n / len : Vec3(0, 0, 0);
+}
+
 std::vector<Vec3> vertex_normals(const TriMesh& mesh, unsigned threads) {
   std::vector<Vec3> normals(mesh.n_vertices(), Vec3(0, 0, 0));
   parallel_for(mesh.n_vertices(), threads, [&](std::size_t i) {
-    const auto v = mesh.vertex_handle(static_cast<unsigned>(i));
-    Vec3 n(0, 0, 0);
-    for (auto f : mesh.vf_range(v)) n += face_normal(mesh, f);
-    const double len = n.norm();
-    normals[i] = len > 0 ? n / len : Vec3(0, 0, 0);
+    normals[i] = vertex_normal(mesh, mesh.vertex_handle(static_cast<unsigned>(i)));
   });
   return normals;
 }

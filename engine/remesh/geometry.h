@@ -47,7 +47,10 @@ void face_vertices(const TriMesh& mesh, OpenMesh::FaceHandle f, OpenMesh::Vertex
 /// Unnormalised normal of face f from the current points.
 Vec3 face_normal(const TriMesh& mesh, OpenMesh::FaceHandle f);
 
-/// Area-weighted unit vertex normals, one per vertex index (zero for isolated vertices). Parallel.
+/// Area-weighted unit normal of vertex v (zero for an isolated vertex or a degenerate star).
+Vec3 vertex_normal(const TriMesh& mesh, OpenMesh::VertexHandle v);
+
+/// vertex_normal() of every vertex, one per vertex index. Parallel.
 std::vector<Vec3> vertex_normals(const TriMesh& mesh, unsigned threads);
 
 /// 2 pi minus the sum of the angles at interior vertex v (radians; positive at a tip, negative at

@@ -77,13 +77,6 @@ class Cleanup {
   }
 
  private:
-  Vec3 normal_at(VertexHandle v) const {
-    Vec3 n(0, 0, 0);
-    for (auto f : mesh_.vf_range(v)) n += geom::face_normal(mesh_, f);
-    const double len = n.norm();
-    return len > 0 ? n / len : n;
-  }
-
   bool try_flip(EdgeHandle e) {
     if (mesh_.is_boundary(e)) return false;
     const HalfedgeHandle h0 = mesh_.halfedge_handle(e, 0), h1 = mesh_.halfedge_handle(e, 1);
@@ -110,7 +103,7 @@ class Cleanup {
     const VertexHandle removed = mesh_.from_vertex_handle(plan.halfedge);
     const bool on_boundary = mesh_.is_boundary(kept) || mesh_.is_boundary(removed);
     if (free_placement && on_boundary) return false;  // a boundary vertex stays where plan_collapse put it
-    const Vec3 normal = normal_at(kept) + normal_at(removed);
+    const Vec3 normal = geom::vertex_normal(mesh_, kept) + geom::vertex_normal(mesh_, removed);
     Vec3 p = plan.position;
     if (free_placement) p = settle(p, collapse_neighbours(mesh_, plan.halfedge), normal);
     if (!mesh_.is_boundary(kept) || mesh_.is_boundary(mesh_.edge_handle(plan.halfedge)))
@@ -161,7 +154,7 @@ class Cleanup {
     const VertexHandle v0 = mesh_.from_vertex_handle(h), v1 = mesh_.to_vertex_handle(h);
     const Vec3 a = mesh_.point(v0), b = mesh_.point(v1);
     const std::vector<Vec3> around = split_neighbours(mesh_, e);
-    const Vec3 normal = normal_at(v0) + normal_at(v1);
+    const Vec3 normal = geom::vertex_normal(mesh_, v0) + geom::vertex_normal(mesh_, v1);
     const Vec3 p0 = a + (b - a) * equalizing_parameter(a, b, around, target());
     auto project = [&](const Vec3& x) {
       if (!mesh_.is_boundary(e)) return reference_.closest_point(x, normal);
@@ -229,11 +222,11 @@ class Cleanup {
     const Vec3 tangent = boundary ? boundary_tangent(v) : Vec3(0, 0, 0);
     if (boundary && tangent.sqrnorm() == 0) return false;
     const Vec3 start = mesh_.point(v);
-    const Vec3 n = normal_at(v);
+    const Vec3 n = geom::vertex_normal(mesh_, v);
     std::vector<Vec3> ring;
     for (auto w : mesh_.vv_range(v)) ring.push_back(mesh_.point(w));
     const Vec3 x = settle(start, ring, n, tangent);
-    const Vec3 p = boundary ? reference_.closest_boundary_point(x) : reference_.closest_point(x, n);
+    const Vec3 p = project_vertex(mesh_, v, x, n, reference_);
     // Progress: fewer star edges outside, or as many but closer to the interval (a strictly
     // decreasing measure, so rounds cannot cycle).
     const auto [n_before, e_before] = outside_around(v, start);
@@ -318,8 +311,8 @@ class Cleanup {
         if (v == pinned || mesh_.is_boundary(v)) continue;
         ring.clear();
         for (auto w : mesh_.vv_range(v)) ring.push_back(mesh_.point(w));
-        const Vec3 n = normal_at(v);
-        const Vec3 p = reference_.closest_point(settle(mesh_.point(v), ring, n), n, patch_caches_[i]);
+        const Vec3 n = geom::vertex_normal(mesh_, v);
+        const Vec3 p = project_vertex(mesh_, v, settle(mesh_.point(v), ring, n), n, reference_, &patch_caches_[i]);
         if (geom::move_is_safe(mesh_, v, p)) mesh_.point(v) = p;
       }
     }

@@ -9,9 +9,9 @@
 namespace remesh {
 
 Vec3 project_vertex(const TriMesh& mesh, OpenMesh::VertexHandle v, const Vec3& p, const Vec3& normal,
-                    const ReferenceSurface& reference) {
+                    const ReferenceSurface& reference, NeighbourCache* cache) {
   if (mesh.is_boundary(v) && reference.has_boundary()) return reference.closest_boundary_point(p);
-  return reference.closest_point(p, normal);
+  return cache ? reference.closest_point(p, normal, *cache) : reference.closest_point(p, normal);
 }
 
 double project_onto_reference(TriMesh& mesh, const ReferenceSurface& reference, unsigned threads,
@@ -31,9 +31,7 @@ double project_onto_reference(TriMesh& mesh, const ReferenceSurface& reference, 
         target[i] = p;
         continue;
       }
-      const bool interior = !(mesh.is_boundary(v) && reference.has_boundary());
-      target[i] = caches && interior ? reference.closest_point(p, normals[i], (*caches)[i])
-                                     : project_vertex(mesh, v, p, normals[i], reference);
+      target[i] = project_vertex(mesh, v, p, normals[i], reference, caches ? &(*caches)[i] : nullptr);
       worst = std::max(worst, (target[i] - p).norm());
     }
     block_max[block] = worst;

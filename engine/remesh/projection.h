@@ -21,8 +21,8 @@ double project_onto_reference(TriMesh& mesh, const ReferenceSurface& reference, 
                               std::vector<NeighbourCache>* caches = nullptr);
 
 /// The position one vertex would take: closest_boundary_point for boundary vertices, else
-/// closest_point with `normal` as the hint.
+/// closest_point with `normal` as the hint (through `cache` when given).
 Vec3 project_vertex(const TriMesh& mesh, OpenMesh::VertexHandle v, const Vec3& p, const Vec3& normal,
-                    const ReferenceSurface& reference);
+                    const ReferenceSurface& reference, NeighbourCache* cache = nullptr);
 
 }  // namespace remesh
