@@ -305,15 +305,19 @@ class Cleanup {
     std::vector<Vec3> ring;
     // Each vertex moves a little per sweep: its kd-tree answer is mostly reusable (reference_surface.h).
     patch_caches_.assign(patch.size(), NeighbourCache{});
-    for (int sweep = 0; ok && sweep < kPatchSweeps; ++sweep) {
+    // A sweep in which no vertex moved ends the relaxation (the next would not move any either).
+    for (int sweep = 0, moved = 1; ok && moved && sweep < kPatchSweeps; ++sweep) {
+      moved = 0;
       for (std::size_t i = 0; i < patch.size(); ++i) {
         const VertexHandle v = patch[i];
         if (v == pinned || mesh_.is_boundary(v)) continue;
         ring.clear();
         for (auto w : mesh_.vv_range(v)) ring.push_back(mesh_.point(w));
         const Vec3 n = geom::vertex_normal(mesh_, v);
-        const Vec3 p = project_vertex(mesh_, v, settle(mesh_.point(v), ring, n), n, reference_, &patch_caches_[i]);
-        if (geom::move_is_safe(mesh_, v, p)) mesh_.point(v) = p;
+        const Vec3 x = settle(mesh_.point(v), ring, n);
+        if (x == mesh_.point(v)) continue;  // its edges are well inside: settle leaves it, so does the projection
+        const Vec3 p = project_vertex(mesh_, v, x, n, reference_, &patch_caches_[i]);
+        if (geom::move_is_safe(mesh_, v, p)) mesh_.point(v) = p, moved = 1;
       }
     }
     if (ok) {
