@@ -4,6 +4,7 @@
 #include <cmath>
 #include <fstream>
 #include <iomanip>
+#include <limits>
 #include <stdexcept>
 #include <vector>
 
@@ -13,6 +14,7 @@
 #ifdef REMESH_BENCH_HAS_IO
 #include "io/mesh_io.h"
 #endif
+#include "remesh/geometry.h"
 #include "remesh/reference_surface.h"
 #include "remesh/statistics.h"
 
@@ -130,6 +132,33 @@ double one_sided(const TriMesh& from, const ReferenceSurface& to, std::size_t sa
 double hausdorff_distance(const TriMesh& a, const TriMesh& b, std::size_t samples, unsigned threads) {
   const ReferenceSurface ra(a), rb(b);
   return std::max(one_sided(a, rb, samples, threads), one_sided(b, ra, samples, threads));
+}
+
+std::vector<double> thickness_at(const TriMesh& surface, const std::vector<Vec3>& points,
+                                 const std::vector<Vec3>& normals, unsigned threads) {
+  struct Face {
+    Vec3 a, b, c, n;
+  };
+  std::vector<Face> faces;
+  faces.reserve(surface.n_faces());
+  for (auto f : surface.faces()) {
+    Vec3 c[3];
+    int k = 0;
+    for (auto v : surface.fv_range(f)) c[k++] = surface.point(v);
+    Vec3 n = (c[1] - c[0]) % (c[2] - c[0]);
+    const double l = n.norm();
+    if (l > 0) faces.push_back({c[0], c[1], c[2], n / l});
+  }
+  std::vector<double> out(points.size(), std::numeric_limits<double>::infinity());
+  parallel_for(points.size(), threads, [&](std::size_t i) {
+    double best = std::numeric_limits<double>::infinity();
+    for (const Face& f : faces) {
+      if ((f.n | normals[i]) > -0.3) continue;
+      best = std::min(best, (geom::closest_point_on_triangle(points[i], f.a, f.b, f.c) - points[i]).sqrnorm());
+    }
+    out[i] = std::sqrt(best);
+  }, 1);
+  return out;
 }
 
 double peak_rss_mib() {

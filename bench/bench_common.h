@@ -5,6 +5,7 @@
 
 #include <cstddef>
 #include <string>
+#include <vector>
 
 #include "core/mesh.h"
 
@@ -34,6 +35,13 @@ double bbox_diagonal(const TriMesh& mesh);
 /// against a ReferenceSurface (kd-tree, 30 nearest vertices) of the other mesh; the larger of the
 /// two one-sided maxima.
 double hausdorff_distance(const TriMesh& a, const TriMesh& b, std::size_t samples, unsigned threads);
+
+/// Local thickness of `surface` at each point p (with unit normal n, pointing out): the distance
+/// from p to the nearest point of a face of `surface` whose normal opposes n (dot < -0.3), i.e. the
+/// other side of the part p lies on; infinity when there is none. Brute force over the faces: for
+/// a few thousand points.
+std::vector<double> thickness_at(const TriMesh& surface, const std::vector<Vec3>& points,
+                                 const std::vector<Vec3>& normals, unsigned threads);
 
 /// Peak resident set size of this process so far (VmHWM), in MiB.
 double peak_rss_mib();

@@ -16,6 +16,8 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -26,6 +28,7 @@
 
 #include "bench_common.h"
 #include "remesh/equalize.h"
+#include "remesh/geometry.h"
 #ifdef REMESH_BENCH_HAS_CGAL
 #include "cgal_isotropic.h"
 #endif
@@ -129,6 +132,40 @@ void print_row(const IterationStats& s) {
   std::fflush(stdout);
 }
 
+/// Where are the edges left outside the interval? The input's thickness at their midpoints (the
+/// other side of the part they lie on), against that at the edges inside. A tube thinner than
+/// 2 e_min / sqrt(3) cannot carry a ring of three vertices on the surface with edges of e_min or
+/// more: there the interval is out of reach without changing the surface.
+void print_thin_parts(const TriMesh& input, const TriMesh& output, const Options& o) {
+  std::vector<Vec3> mids[2], normals[2];  // [0] outside, [1] inside (a sample of at most 4000)
+  const std::size_t stride = std::max<std::size_t>(1, output.n_edges() / 4000);
+  std::size_t k = 0;
+  for (auto e : output.edges()) {
+    const double l = output.calc_edge_length(e);
+    const int in = l >= kEmin && l <= kEmax;
+    if (in && k++ % stride != 0) continue;
+    const auto h = output.halfedge_handle(e, 0);
+    Vec3 n(0, 0, 0);
+    for (auto g : {h, output.opposite_halfedge_handle(h)})
+      if (!output.is_boundary(g)) n += geom::face_normal(output, output.face_handle(g)).normalized();
+    if (n.norm() == 0) continue;
+    mids[in].push_back((output.point(output.from_vertex_handle(h)) + output.point(output.to_vertex_handle(h))) * 0.5);
+    normals[in].push_back(n.normalized());
+  }
+  std::vector<double> t[2];
+  for (int i = 0; i < 2; ++i) {
+    t[i] = bench::thickness_at(input, mids[i], normals[i], o.threads);
+    std::sort(t[i].begin(), t[i].end());
+  }
+  if (t[0].empty()) return;
+  const double tube = 2 * kEmin / std::sqrt(3.0);
+  const auto thin = std::lower_bound(t[0].begin(), t[0].end(), tube) - t[0].begin();
+  auto median = [](const std::vector<double>& v) { return v.empty() ? 0.0 : v[v.size() / 2]; };
+  std::printf("ours : %zu edges outside; the input's thickness at them: median %.2f (at edges inside: %.2f); %zu of "
+              "them where it is below %.2f = 2 e_min / sqrt(3)\n",
+              t[0].size(), median(t[0]), median(t[1]), static_cast<std::size_t>(thin), tube);
+}
+
 /// The quality row printed for each remesher.
 void print_quality(const char* who, const TriMesh& input, const TriMesh& output, const bench::Topology& topo_in,
                    const ChildResult& r, const Options& o) {
@@ -146,6 +183,7 @@ void print_quality(const char* who, const TriMesh& input, const TriMesh& output,
                   ? "preserved"
                   : "CHANGED",
               t.euler, t.boundary_loops, t.components);
+  if (std::string(who) == "ours" && s.small + s.big > 0) print_thin_parts(input, output, o);
 }
 
 void run_setup(const std::string& path, const char* setup, double mean_edge, const Options& o, const fs::path& dir) {
