@@ -142,12 +142,13 @@ std::vector<double> thickness_at(const TriMesh& surface, const std::vector<Vec3>
   std::vector<Face> faces;
   faces.reserve(surface.n_faces());
   for (auto f : surface.faces()) {
+    const Vec3 n = geom::face_normal(surface, f);
+    const double l = n.norm();
+    if (!(l > 0)) continue;
     Vec3 c[3];
     int k = 0;
     for (auto v : surface.fv_range(f)) c[k++] = surface.point(v);
-    Vec3 n = (c[1] - c[0]) % (c[2] - c[0]);
-    const double l = n.norm();
-    if (l > 0) faces.push_back({c[0], c[1], c[2], n / l});
+    faces.push_back({c[0], c[1], c[2], n / l});
   }
   std::vector<double> out(points.size(), std::numeric_limits<double>::infinity());
   parallel_for(points.size(), threads, [&](std::size_t i) {

@@ -152,12 +152,12 @@ void print_thin_parts(const TriMesh& input, const TriMesh& output, const Options
     mids[in].push_back((output.point(output.from_vertex_handle(h)) + output.point(output.to_vertex_handle(h))) * 0.5);
     normals[in].push_back(n.normalized());
   }
+  if (mids[0].empty()) return;  // every edge inside: nothing to explain
   std::vector<double> t[2];
   for (int i = 0; i < 2; ++i) {
     t[i] = bench::thickness_at(input, mids[i], normals[i], o.threads);
     std::sort(t[i].begin(), t[i].end());
   }
-  if (t[0].empty()) return;
   const double tube = 2 * kEmin / std::sqrt(3.0);
   const auto thin = std::lower_bound(t[0].begin(), t[0].end(), tube) - t[0].begin();
   auto median = [](const std::vector<double>& v) { return v.empty() ? 0.0 : v[v.size() / 2]; };
@@ -183,7 +183,6 @@ void print_quality(const char* who, const TriMesh& input, const TriMesh& output,
                   ? "preserved"
                   : "CHANGED",
               t.euler, t.boundary_loops, t.components);
-  if (std::string(who) == "ours" && s.small + s.big > 0) print_thin_parts(input, output, o);
 }
 
 void run_setup(const std::string& path, const char* setup, double mean_edge, const Options& o, const fs::path& dir) {
@@ -225,7 +224,9 @@ void run_setup(const std::string& path, const char* setup, double mean_edge, con
   if (!ours.ok) {
     std::printf("ours : FAILED\n");
   } else {
-    print_quality("ours", input, bench::load_mesh(ours_out), topo_in, ours, o);
+    const TriMesh output = bench::load_mesh(ours_out);
+    print_quality("ours", input, output, topo_in, ours, o);
+    print_thin_parts(input, output, o);
   }
 #ifdef REMESH_BENCH_HAS_CGAL
   if (o.cgal) {
