@@ -15,8 +15,8 @@
 #include "io/mesh_io.h"
 #endif
 #include "remesh/geometry.h"
-#include "remesh/reference_surface.h"
 #include "remesh/statistics.h"
+#include "triangle_bvh.h"
 
 namespace remesh::bench {
 
@@ -99,7 +99,7 @@ double bbox_diagonal(const TriMesh& mesh) {
 namespace {
 
 /// Largest distance from the samples of `from` to the surface `to`.
-double one_sided(const TriMesh& from, const ReferenceSurface& to, std::size_t samples, unsigned threads) {
+double one_sided(const TriMesh& from, const TriangleBvh& to, std::size_t samples, unsigned threads) {
   double area = 0;
   for (auto f : from.faces()) area += from.calc_face_area(f);
   const double per_area = area > 0 ? static_cast<double>(samples) / area : 0;
@@ -119,7 +119,7 @@ double one_sided(const TriMesh& from, const ReferenceSurface& to, std::size_t sa
         for (int w = 0; u + w <= n; ++w) {
           const double a = double(u) / n, bb = double(w) / n;
           const Vec3 p = c[0] * (1 - a - bb) + c[1] * a + c[2] * bb;
-          worst = std::max(worst, (to.closest_point(p) - p).norm());
+          worst = std::max(worst, to.distance(p));
         }
     }
     face_max[block] = worst;
@@ -130,7 +130,7 @@ double one_sided(const TriMesh& from, const ReferenceSurface& to, std::size_t sa
 }  // namespace
 
 double hausdorff_distance(const TriMesh& a, const TriMesh& b, std::size_t samples, unsigned threads) {
-  const ReferenceSurface ra(a), rb(b);
+  const TriangleBvh ra(a), rb(b);
   return std::max(one_sided(a, rb, samples, threads), one_sided(b, ra, samples, threads));
 }
 

@@ -32,8 +32,8 @@ double bbox_diagonal(const TriMesh& mesh);
 
 /// Symmetric Hausdorff distance between a and b, estimated by sampling: every vertex plus about
 /// `samples` points spread over the faces by area (barycentric grid per face), each measured
-/// against a ReferenceSurface (kd-tree, 30 nearest vertices) of the other mesh; the larger of the
-/// two one-sided maxima.
+/// exactly against the other mesh's triangles (triangle_bvh.h); the larger of the two one-sided
+/// maxima.
 double hausdorff_distance(const TriMesh& a, const TriMesh& b, std::size_t samples, unsigned threads);
 
 /// Local thickness of `surface` at each point p (with unit normal n, pointing out): the distance

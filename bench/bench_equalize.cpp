@@ -256,8 +256,8 @@ int main(int argc, char** argv) {
                                           : fs::path(o.keep_dir);
   fs::create_directories(dir);
   std::printf("bench_equalize: Hausdorff = max of the two one-sided maxima over every vertex plus ~%zu barycentric "
-              "samples per mesh, each measured to the other mesh's surface (kd-tree, 30 nearest vertices, their "
-              "triangles); time = the remeshing call alone; peak = ru_maxrss of the forked child (load + remesh + "
+              "samples per mesh, each measured exactly to the other mesh's triangles (bounding-volume hierarchy); "
+              "time = the remeshing call alone; peak = ru_maxrss of the forked child (load + remesh + "
               "write); threads %u (0 = all cores; CGAL runs on one)\n",
               o.samples, o.threads);
   int failures = 0;
