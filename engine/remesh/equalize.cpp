@@ -259,8 +259,8 @@ Result equalize(TriMesh& mesh, const Params& params, const OnIteration& on_itera
       held.clear();
     }
     const bool ending = outcome != Outcome::Completed || i == params.iterations;
-    // Not in the thesis: before the mesh is returned, tips and creases of the reference are put
-    // back on it (feature_snap.h); no edge leaves the interval.
+    // Not in the thesis: before the mesh is returned, the reference vertices it cuts off (tips,
+    // creases) are put back on it (feature_snap.h); no edge leaves the interval.
     if (ending && params.cleanup && !stop.stop_requested()) {
       const std::size_t snapped = features->apply(mesh, *reference, params.e_min, params.e_max, threads);
       if (snapped > 0) {

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <vector>
 
 #include "remesh/geometry.h"
@@ -17,6 +18,57 @@ using OpenMesh::HalfedgeHandle;
 using OpenMesh::VertexHandle;
 
 namespace {
+
+/// The feature snap's guard for the Hausdorff distance: the snap's target and the reference points
+/// that lie within e_min of a patch's faces (the ones a relaxation of the patch could pull away
+/// from) may not end up farther from those faces than the farthest of them was before. Points
+/// farther from the patch are closer to faces it does not move, so their distance cannot grow.
+class GapJudge {
+ public:
+  /// `reach`: a distance from the target beyond which no point is within e_min of the faces.
+  GapJudge(const TriMesh& mesh, std::vector<OpenMesh::FaceHandle> faces, const Vec3& target,
+           const std::vector<Vec3>& points, double e_min, double reach)
+      : faces_(std::move(faces)) {
+    consider(mesh, target, std::numeric_limits<double>::max());  // the point to bring in, however far
+    for (const Vec3& q : points)
+      if (q != target && (q - target).sqrnorm() < reach * reach) consider(mesh, q, e_min);
+  }
+
+  /// Does every judged point lie within the limit of the (moved) faces?
+  bool holds(const TriMesh& mesh) const {
+    for (std::size_t k = 0; k < points_.size(); ++k) {
+      // The face that was nearest usually still is: its distance bounds the point's from above.
+      if (distance(mesh, points_[k], nearest_[k]) <= limit_) continue;
+      double d = std::numeric_limits<double>::max();
+      for (auto f : faces_) d = std::min(d, distance(mesh, points_[k], f));
+      if (d > limit_) return false;
+    }
+    return true;
+  }
+
+ private:
+  static double distance(const TriMesh& mesh, const Vec3& q, OpenMesh::FaceHandle f) {
+    auto fv = mesh.cfv_iter(f);
+    const Vec3 &a = mesh.point(*fv), &b = mesh.point(*++fv), &c = mesh.point(*++fv);
+    return (geom::closest_point_on_triangle(q, a, b, c) - q).norm();
+  }
+
+  void consider(const TriMesh& mesh, const Vec3& q, double within) {
+    double d = std::numeric_limits<double>::max();
+    OpenMesh::FaceHandle nearest;
+    for (auto f : faces_)
+      if (const double x = distance(mesh, q, f); x < d) d = x, nearest = f;
+    if (d >= within) return;
+    points_.push_back(q);
+    nearest_.push_back(nearest);
+    limit_ = std::max(limit_, d);
+  }
+
+  std::vector<OpenMesh::FaceHandle> faces_;
+  std::vector<Vec3> points_;
+  std::vector<OpenMesh::FaceHandle> nearest_;
+  double limit_ = 0;
+};
 
 class Cleanup {
  public:
@@ -269,11 +321,9 @@ class Cleanup {
     return std::find(failed_patches_.begin(), failed_patches_.end(), e.idx()) != failed_patches_.end();
   }
 
-  /// Moves `pinned` (if valid) to `pin_at`, then relaxes the other interior vertices within
-  /// kPatchRings rings of `seeds` (which include `pinned`). Keeps the result if the patch's edges
-  /// outside the interval are fewer, or as many with 10 % less squared excess, or (with
-  /// `allow_equal`) not more; else every vertex goes back.
-  bool relax_patch(std::vector<VertexHandle> patch, VertexHandle pinned, const Vec3& pin_at, bool allow_equal) {
+  /// Adds to `patch` every vertex within kPatchRings rings of it, marking all in patch_mark_ (the
+  /// caller clears the marks).
+  void grow_patch(std::vector<VertexHandle>& patch) {
     std::vector<char>& in = patch_mark_;
     if (in.size() < mesh_.n_vertices()) in.assign(mesh_.n_vertices(), 0);
     for (auto v : patch) in[v.idx()] = 1;
@@ -284,6 +334,30 @@ class Cleanup {
           if (!in[w.idx()]) in[w.idx()] = 1, patch.push_back(w);
       begin = end;
     }
+  }
+
+  /// The faces a relaxation of the patch around v can move: those incident to its vertices.
+  std::vector<OpenMesh::FaceHandle> patch_faces(VertexHandle v) {
+    std::vector<VertexHandle> patch{v};
+    grow_patch(patch);
+    std::vector<OpenMesh::FaceHandle> faces;
+    for (auto u : patch) {
+      patch_mark_[u.idx()] = 0;
+      for (auto f : mesh_.vf_range(u)) faces.push_back(f);
+    }
+    std::sort(faces.begin(), faces.end());
+    faces.erase(std::unique(faces.begin(), faces.end()), faces.end());
+    return faces;
+  }
+
+  /// Moves `pinned` (if valid) to `pin_at`, then relaxes the other interior vertices within
+  /// kPatchRings rings of `seeds` (which include `pinned`). Keeps the result if the patch's edges
+  /// outside the interval are fewer, or as many with 10 % less squared excess, or (with
+  /// `allow_equal`) not more; else every vertex goes back.
+  bool relax_patch(std::vector<VertexHandle> patch, VertexHandle pinned, const Vec3& pin_at, bool allow_equal,
+                   const GapJudge* judge = nullptr) {
+    std::vector<char>& in = patch_mark_;
+    grow_patch(patch);
     // Edges of the patch: those with an end inside it.
     auto measure = [&]() {
       std::size_t n = 0;
@@ -323,6 +397,7 @@ class Cleanup {
     if (ok) {
       const auto [n_after, e_after] = measure();
       ok = n_after < n_before || (n_after == n_before && (allow_equal || e_after < 0.9 * e_before));
+      ok = ok && (!judge || judge->holds(mesh_));
     }
     if (!ok)
       for (std::size_t i = 0; i < patch.size(); ++i) mesh_.point(patch[i]) = saved[i];
@@ -332,14 +407,29 @@ class Cleanup {
 
  public:
   /// See snap_to_features() in interval_cleanup.h.
-  bool snap(VertexHandle v, const Vec3& target) {
-    if (mesh_.is_boundary(v)) return false;
-    return relax_patch({v}, v, target, true);
+  bool snap(const SnapMove& move, const std::vector<Vec3>& features, std::size_t& budget) {
+    const VertexHandle v = move.v;
+    if (mesh_.is_boundary(v) || budget == 0) return false;
+    // The patch's faces lie within kPatchRings + 1 edges of v.
+    const double reach = (move.target - mesh_.point(v)).norm() + (kPatchRings + 1) * e_max_ + e_min_;
+    const GapJudge judge(mesh_, patch_faces(v), move.target, features, e_min_, reach);
+    --budget;
+    if (relax_patch({v}, v, move.target, true, &judge)) return true;
+    if (!move.partial) return false;
+    const Vec3 from = mesh_.point(v);
+    for (double s : kPartialSnaps) {
+      if (budget == 0) break;
+      --budget;
+      if (relax_patch({v}, v, reference_.closest_point(from + s * (move.target - from)), true, &judge)) return true;
+    }
+    return false;
   }
 
  private:
   static constexpr std::size_t kPatchRings = 2;
   static constexpr int kPatchSweeps = 6;
+  /// When the vertex cannot reach the feature point, the fractions of the way to it tried in turn.
+  static constexpr double kPartialSnaps[] = {0.85, 0.7, 0.55, 0.4, 0.25};
 
   TriMesh& mesh_;
   const ReferenceSurface& reference_;
@@ -357,11 +447,12 @@ class Cleanup {
 }  // namespace
 
 std::size_t snap_to_features(TriMesh& mesh, const ReferenceSurface& reference, double e_min, double e_max,
-                             const std::vector<std::pair<OpenMesh::VertexHandle, Vec3>>& moves) {
+                             const std::vector<SnapMove>& moves, const std::vector<Vec3>& features,
+                             std::size_t& budget) {
   Cleanup cleanup(mesh, reference, e_min, e_max, 0.5);
   std::size_t moved = 0;
-  for (const auto& [v, target] : moves)
-    if (cleanup.snap(v, target)) ++moved;
+  for (const SnapMove& move : moves)
+    if (cleanup.snap(move, features, budget)) ++moved;
   return moved;
 }
 

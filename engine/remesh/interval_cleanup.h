@@ -40,11 +40,22 @@ struct CleanupCounts {
 CleanupCounts interval_cleanup(TriMesh& mesh, const ReferenceSurface& reference, double e_min, double e_max,
                                double flip_factor, int rounds = 4, bool boundary_only = false);
 
-/// Moves each listed vertex onto its target point (a point of the reference) and relaxes the
-/// interior vertices within 2 rings of it around the pinned vertex, as the patch relaxation does;
-/// keeps a move only if it folds nothing and leaves no more edges of the patch outside
-/// [e_min, e_max] than before. Returns the number of moves kept. Used by feature_snap.h.
+/// A move of the feature snap (feature_snap.h): vertex v onto target, a point of the reference.
+/// With `partial`, when the whole move is refused, fractions of it are tried in turn (for the
+/// points that decide the Hausdorff distance: the search costs a patch relaxation per fraction).
+struct SnapMove {
+  OpenMesh::VertexHandle v;
+  Vec3 target;
+  bool partial = false;
+};
+
+/// Makes each move and relaxes the interior vertices within 2 rings of the moved vertex, as the
+/// patch relaxation does; keeps a move only if it folds nothing, leaves no more edges of the patch
+/// outside [e_min, e_max] than before, and leaves none of the `features` points near the patch
+/// farther from it than the farthest of them was. Each try (a patch relaxation) takes one from
+/// `budget`; none is made when it is 0. Returns the number of moves kept.
 std::size_t snap_to_features(TriMesh& mesh, const ReferenceSurface& reference, double e_min, double e_max,
-                             const std::vector<std::pair<OpenMesh::VertexHandle, Vec3>>& moves);
+                             const std::vector<SnapMove>& moves, const std::vector<Vec3>& features,
+                             std::size_t& budget);
 
 }  // namespace remesh

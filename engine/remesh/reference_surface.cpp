@@ -68,9 +68,12 @@ struct ReferenceSurface::Impl {
       std::pair<double, std::uint32_t> by_distance[NeighbourCache::kCacheSize];
       for (std::uint32_t i = 0; i < cache.count; ++i)
         by_distance[i] = {(points[cache.idx[i]] - p).sqrnorm(), cache.idx[i]};
-      std::partial_sort(by_distance, by_distance + k, by_distance + cache.count);
+      // The k nearest, unordered but for the nearest first (closest_point prunes by it).
+      std::nth_element(by_distance, by_distance + (k - 1), by_distance + cache.count);
+      std::iter_swap(by_distance, std::min_element(by_distance, by_distance + k));
       const double moved = (p - cache.query).norm();
-      if (std::sqrt(by_distance[k - 1].first) + moved < cache.radius) {
+      const double kth = std::max_element(by_distance, by_distance + k)->first;
+      if (std::sqrt(kth) + moved < cache.radius) {
         for (std::size_t i = 0; i < k; ++i) idx[i] = by_distance[i].second;
         return k;
       }

@@ -359,7 +359,11 @@ TEST_CASE("feature snap puts a cut tip back on the mesh without taking edges out
   const FeatureSnap features(reference);
   REQUIRE(features.size() >= 1);
   const ReferenceSurface surface(reference);
-  CHECK(features.apply(mesh, surface, 1.2, 1.8, 2) >= 1);
+  std::size_t none = 0;  // no budget: no try
+  CHECK(features.pass(mesh, surface, 1.2, 1.8, 2, none) == 0);
+  std::size_t budget = 8;
+  CHECK(features.pass(mesh, surface, 1.2, 1.8, 2, budget) >= 1);
+  CHECK(budget < 8);
   double gap = 1e9;
   for (auto v : mesh.vertices()) gap = std::min(gap, (mesh.point(v) - tip).norm());
   CHECK(gap < 1e-9);
@@ -368,5 +372,61 @@ TEST_CASE("feature snap puts a cut tip back on the mesh without taking edges out
   // Every vertex lies on the reference.
   for (auto v : mesh.vertices()) CHECK((surface.closest_point(mesh.point(v)) - mesh.point(v)).norm() < 1e-9);
   // A second pass finds nothing far any more.
-  CHECK(features.apply(mesh, surface, 1.2, 1.8, 2) == 0);
+  const std::size_t left = budget;
+  CHECK(features.pass(mesh, surface, 1.2, 1.8, 2, budget) == 0);
+  CHECK(budget == left);
+}
+
+TEST_CASE("feature snap brings a sharp tip nearer without taking edges out or pulling the surface away elsewhere",
+          "[steps]") {
+  // Tips of rising sharpness on a lattice whose edges all lie in [1.2, 1.8]: from 2.0 the apex
+  // cannot carry a vertex with edges in the interval; then a part of the move (kPartialSnaps) may
+  // still be kept. Always: no edge leaves the interval, no reference vertex ends up farther from
+  // the mesh than the farthest was, and the mesh stays valid with its moved vertices on the reference.
+  for (const double height : {1.2, 2.0, 3.0, 4.5}) {
+    CAPTURE(height);
+    TriMesh reference = test::make_hex_lattice_patch(12, 12, 1.5);  // every edge inside [1.2, 1.8]
+    Vec3 middle(0, 0, 0);
+    for (auto v : reference.vertices()) middle += reference.point(v) / double(reference.n_vertices());
+    OpenMesh::VertexHandle centre;
+    double best = 1e9;
+    for (auto v : reference.vertices())
+      if (const double d = (reference.point(v) - middle).norm(); d < best) best = d, centre = v;
+    TriMesh mesh = reference;
+    reference.point(centre)[2] += height;
+    const ReferenceSurface surface(reference);
+    auto outside = [](const TriMesh& m) {
+      std::size_t n = 0;
+      for (auto e : m.edges())
+        if (m.calc_edge_length(e) < 1.2 || m.calc_edge_length(e) > 1.8) ++n;
+      return n;
+    };
+    auto farthest = [&](const TriMesh& m) {
+      const ReferenceSurface now(m);
+      double far = 0;
+      for (auto v : reference.vertices())
+        if (!reference.is_boundary(v)) far = std::max(far, (now.closest_point(reference.point(v)) - reference.point(v)).norm());
+      return far;
+    };
+    const std::size_t outside_before = outside(mesh);
+    const double far_before = farthest(mesh);
+    const FeatureSnap features(reference);
+    std::size_t budget = 64;
+    const TriMesh before = mesh;
+    const std::size_t kept = features.pass(mesh, surface, 1.2, 1.8, 2, budget);
+    CHECK(outside(mesh) <= outside_before);
+    CHECK(farthest(mesh) <= far_before);
+    // Up to 2.0 (an apex angle of 74 degrees) a move or a part of it is kept; the mesh vertex
+    // nearest the tip sits under its apex, so a part of the way that starts there ends inside a
+    // steeper cone, and its projection lands on a side (the move may be refused as a fold).
+    if (height <= 2.0) {
+      CHECK(kept >= 1);
+      CHECK(farthest(mesh) < far_before);
+    }
+    CHECK(test::check_mesh_valid(mesh) == "");
+    // Every vertex that moved lies on the reference (the flat grid's centre is not, until it moves).
+    for (auto v : mesh.vertices())
+      if (mesh.point(v) != before.point(v))
+        CHECK((surface.closest_point(mesh.point(v)) - mesh.point(v)).norm() < 1e-9);
+  }
 }
