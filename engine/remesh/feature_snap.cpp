@@ -1,11 +1,9 @@
 #include "remesh/feature_snap.h"
 
 #include <algorithm>
-#include <cmath>
 #include <cstdint>
 
 #include "core/parallel.h"
-#include "remesh/geometry.h"
 #include "remesh/interval_cleanup.h"
 #include "remesh/reference_surface.h"
 
