@@ -416,11 +416,13 @@ class Cleanup {
     --budget;
     if (relax_patch({v}, v, move.target, true, &judge)) return true;
     if (!move.partial) return false;
-    const Vec3 from = mesh_.point(v);
+    const Vec3 from = mesh_.point(v), n = geom::vertex_normal(mesh_, v);
     for (double s : kPartialSnaps) {
       if (budget == 0) break;
       --budget;
-      if (relax_patch({v}, v, reference_.closest_point(from + s * (move.target - from)), true, &judge)) return true;
+      // Projected like every other vertex move (the normal keeps it on its own sheet).
+      const Vec3 partial = project_vertex(mesh_, v, from + s * (move.target - from), n, reference_);
+      if (relax_patch({v}, v, partial, true, &judge)) return true;
     }
     return false;
   }

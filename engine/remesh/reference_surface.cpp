@@ -70,9 +70,9 @@ struct ReferenceSurface::Impl {
         by_distance[i] = {(points[cache.idx[i]] - p).sqrnorm(), cache.idx[i]};
       // The k nearest, unordered but for the nearest first (closest_point prunes by it).
       std::nth_element(by_distance, by_distance + (k - 1), by_distance + cache.count);
+      const double kth = by_distance[k - 1].first;
       std::iter_swap(by_distance, std::min_element(by_distance, by_distance + k));
       const double moved = (p - cache.query).norm();
-      const double kth = std::max_element(by_distance, by_distance + k)->first;
       if (std::sqrt(kth) + moved < cache.radius) {
         for (std::size_t i = 0; i < k; ++i) idx[i] = by_distance[i].second;
         return k;
