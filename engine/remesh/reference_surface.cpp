@@ -44,6 +44,12 @@ struct ReferenceSurface::Impl {
   std::vector<Vec3> centres;        ///< per triangle: centroid
   std::vector<double> radii;        ///< per triangle: largest distance centroid -> corner
   Csr vertex_triangles;             ///< triangles incident to each vertex
+  /// per triangle: the triangle across its edge (corner k, corner k+1), or kNone (boundary or
+  /// non-manifold edge)
+  std::vector<std::array<std::uint32_t, 3>> across;
+  static constexpr std::uint32_t kNone = UINT32_MAX;
+  /// per triangle: folded back onto a larger neighbour (see kFoldCos); never a candidate
+  std::vector<std::uint8_t> folded;
   Csr vertex_boundary;              ///< other end of each boundary edge at a vertex
   std::size_t boundary_edges = 0;
   std::size_t neighbours = 30;
@@ -93,6 +99,7 @@ struct ReferenceSurface::Impl {
   }
 
   Vec3 closest_point(const Vec3& p, const Vec3& normal_hint, const std::uint32_t* idx, std::size_t found) const;
+  void walk(const Vec3& p, const Vec3& normal_hint, std::uint32_t& t, Vec3& c, double& d2) const;
 };
 
 ReferenceSurface::ReferenceSurface(const TriMesh& mesh, std::size_t neighbours)
@@ -117,6 +124,7 @@ ReferenceSurface::ReferenceSurface(const TriMesh& mesh, std::size_t neighbours)
   m.unit_normals.resize(nt);
   m.centres.resize(nt);
   m.radii.resize(nt);
+  std::vector<double> areas(nt);
   m.vertex_triangles.offsets.assign(nv + 1, 0);
   for (std::size_t t = 0; t < nt; ++t) {
     const auto& tri = m.triangles[t];
@@ -124,6 +132,7 @@ ReferenceSurface::ReferenceSurface(const TriMesh& mesh, std::size_t neighbours)
     Vec3 n = geom::cross_normal(a, b, c);
     const double len = n.norm();
     m.unit_normals[t] = len > 0 ? n / len : Vec3(0, 0, 0);
+    areas[t] = 0.5 * len;
     m.centres[t] = (a + b + c) / 3.0;
     m.radii[t] = std::sqrt(std::max({(a - m.centres[t]).sqrnorm(), (b - m.centres[t]).sqrnorm(),
                                       (c - m.centres[t]).sqrnorm()}));
@@ -136,6 +145,36 @@ ReferenceSurface::ReferenceSurface(const TriMesh& mesh, std::size_t neighbours)
     for (std::size_t t = 0; t < nt; ++t)
       for (auto v : m.triangles[t]) m.vertex_triangles.items[fill[v]++] = static_cast<std::uint32_t>(t);
   }
+  // Triangles across each edge: match the two halves of every edge through the lower end's list.
+  m.across.assign(nt, {Impl::kNone, Impl::kNone, Impl::kNone});
+  for (std::size_t t = 0; t < nt; ++t)
+    for (int k = 0; k < 3; ++k) {
+      const std::uint32_t a = m.triangles[t][k], b = m.triangles[t][(k + 1) % 3];
+      std::uint32_t other = Impl::kNone;
+      int count = 0;
+      for (std::uint32_t j = m.vertex_triangles.offsets[a]; j < m.vertex_triangles.offsets[a + 1]; ++j) {
+        const std::uint32_t u = m.vertex_triangles.items[j];
+        if (u == t) continue;
+        const auto& tri = m.triangles[u];
+        for (int l = 0; l < 3; ++l)
+          if (tri[l] == b && tri[(l + 1) % 3] == a) other = u, ++count;
+      }
+      if (count == 1) m.across[t][k] = other;
+    }
+  // A triangle whose normal is nearly opposite to that of a larger neighbour across an edge lies
+  // folded back onto it: a defect of the input (nefertiti has 96 such pairs: slivers that close
+  // T-junctions of its base with their third corner on the wrong side). Its normal is noise, and a
+  // vertex that follows it into the fold gets squeezed between the sheets. The neighbours cover the
+  // same place, so the projection ignores it.
+  constexpr double kFoldCos = -0.95;
+  m.folded.assign(nt, 0);
+  for (std::size_t t = 0; t < nt; ++t)
+    for (int k = 0; k < 3; ++k) {
+      const std::uint32_t u = m.across[t][k];
+      if (u != Impl::kNone && (m.unit_normals[t] | m.unit_normals[u]) < kFoldCos &&
+          areas[u] > areas[t])
+        m.folded[t] = 1;
+    }
   // Boundary edges, listed at both ends.
   m.vertex_boundary.offsets.assign(nv + 1, 0);
   std::vector<std::pair<std::uint32_t, std::uint32_t>> segments;
@@ -192,6 +231,7 @@ Vec3 ReferenceSurface::closest_point(const Vec3& p, const Vec3& normal_hint, Nei
 Vec3 ReferenceSurface::Impl::closest_point(const Vec3& p, const Vec3& normal_hint, const std::uint32_t* idx,
                                            std::size_t found) const {
   const Impl& m = *this;
+  constexpr std::uint32_t kNone = Impl::kNone;
 
   // Best candidate overall and best candidate whose normal agrees with the hint. The agreeing one
   // wins when it is nearly as close (two sheets close together: stay on the vertex's own sheet).
@@ -199,10 +239,12 @@ Vec3 ReferenceSurface::Impl::closest_point(const Vec3& p, const Vec3& normal_hin
   constexpr double kInf = std::numeric_limits<double>::max();
   Vec3 best = m.points[idx[0]], best_agree = best;
   double best_d2 = kInf, agree_d2 = kInf, best_d = kInf, agree_d = kInf;
+  std::uint32_t best_t = kNone, agree_t = kNone;
   for (std::size_t i = 0; i < found; ++i) {
     const std::uint32_t v = idx[i];
     for (std::uint32_t j = m.vertex_triangles.offsets[v]; j < m.vertex_triangles.offsets[v + 1]; ++j) {
       const std::uint32_t t = m.vertex_triangles.items[j];
+      if (m.folded[t]) continue;
       const bool agrees = use_hint && (m.unit_normals[t] | normal_hint) > 0;
       // Skip a triangle whose bounding sphere is farther than the candidate it could beat.
       const double bound = agrees ? std::max(best_d, agree_d) : best_d;
@@ -213,17 +255,50 @@ Vec3 ReferenceSurface::Impl::closest_point(const Vec3& p, const Vec3& normal_hin
       const auto& tri = m.triangles[t];
       const Vec3 c = geom::closest_point_on_triangle(p, m.points[tri[0]], m.points[tri[1]], m.points[tri[2]]);
       const double d2 = (c - p).sqrnorm();
-      if (d2 < best_d2) best_d2 = d2, best_d = std::sqrt(d2), best = c;
-      if (agrees && d2 < agree_d2) agree_d2 = d2, agree_d = std::sqrt(d2), best_agree = c;
+      if (d2 < best_d2) best_d2 = d2, best_d = std::sqrt(d2), best = c, best_t = t;
+      if (agrees && d2 < agree_d2) agree_d2 = d2, agree_d = std::sqrt(d2), best_agree = c, agree_t = t;
     }
   }
   // "Nearly as close": within twice the distance of the closest candidate (plus a hair for points
   // already on the surface).
-  if (use_hint && agree_d2 < std::numeric_limits<double>::max()) {
+  if (use_hint && agree_t != kNone) {
     const double scale = 1e-12 * (1.0 + p.sqrnorm());
-    if (agree_d2 <= 4.0 * best_d2 + scale) return best_agree;
+    if (agree_d2 <= 4.0 * best_d2 + scale) {
+      walk(p, normal_hint, agree_t, best_agree, agree_d2);
+      return best_agree;
+    }
   }
+  if (best_t != kNone) walk(p, normal_hint, best_t, best, best_d2);
   return best;
+}
+
+/// Not in Alg. 6: a triangle far larger than its neighbours can lie under p while none of its
+/// corners is among the nearest reference vertices (nefertiti's base: triangles 10-22 units long
+/// beside a dense rim), and then the candidates' closest point sits on the edge line of a
+/// neighbouring triangle. From the winning triangle t, step to the triangle across an edge while
+/// that gets closer, only onto nearly coplanar triangles (kWalkCos) whose normal agrees with the
+/// hint, so a walk never turns round a fold of the reference onto another sheet.
+void ReferenceSurface::Impl::walk(const Vec3& p, const Vec3& normal_hint, std::uint32_t& t, Vec3& c,
+                                  double& d2) const {
+  constexpr int kWalkSteps = 16;
+  constexpr double kWalkCos = 0.9;  // about 25 degrees
+  const bool use_hint = normal_hint.sqrnorm() > 0;
+  for (int step = 0; step < kWalkSteps; ++step) {
+    std::uint32_t next = kNone;
+    Vec3 next_c = c;
+    double next_d2 = d2 * (1.0 - 1e-9);
+    for (int k = 0; k < 3; ++k) {
+      const std::uint32_t u = across[t][k];
+      if (u == kNone || folded[u] || (unit_normals[u] | unit_normals[t]) < kWalkCos) continue;
+      if (use_hint && (unit_normals[u] | normal_hint) <= 0) continue;
+      const auto& tri = triangles[u];
+      const Vec3 q = geom::closest_point_on_triangle(p, points[tri[0]], points[tri[1]], points[tri[2]]);
+      const double e2 = (q - p).sqrnorm();
+      if (e2 < next_d2) next = u, next_c = q, next_d2 = e2;
+    }
+    if (next == kNone) return;
+    t = next, c = next_c, d2 = next_d2;
+  }
 }
 
 Vec3 ReferenceSurface::closest_boundary_point(const Vec3& p) const {

@@ -4,6 +4,10 @@
 /// nanoflann kd-tree over its vertices. closest_point() looks at the triangles incident to the 30
 /// nearest reference vertices and returns the closest point on them; where candidates are nearly as
 /// close (thin parts, two sheets), the one whose normal agrees with `normal_hint` wins.
+/// Two additions to Alg. 6 for uneven and defective inputs (reference_surface.cpp says why): from
+/// the winning triangle, the search walks across edges to nearly coplanar neighbours while that gets
+/// closer (a large triangle none of whose corners is among the 30 nearest), and a triangle folded
+/// back onto a larger neighbour (normals nearly opposite) is never a candidate.
 /// Queries are const and safe from several threads.
 ///
 /// A NeighbourCache lets a caller that queries again from a nearby point (every vertex, every

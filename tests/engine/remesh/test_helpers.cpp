@@ -1,5 +1,9 @@
 #include "test_helpers.h"
 
+#include <algorithm>
+
+#include "remesh/geometry.h"
+
 namespace remesh::test {
 
 double plain_mean_edge(const TriMesh& mesh) {
@@ -27,6 +31,17 @@ double plain_inside_fraction(const TriMesh& mesh, double lo, double hi) {
     ++n;
   }
   return n ? static_cast<double>(in) / static_cast<double>(n) : 1.0;
+}
+
+double brute_distance(const TriMesh& mesh, const Vec3& p) {
+  double best = 1e300;
+  for (auto f : mesh.faces()) {
+    Vec3 q[3];
+    int k = 0;
+    for (auto v : mesh.fv_range(f)) q[k++] = mesh.point(v);
+    best = std::min(best, (geom::closest_point_on_triangle(p, q[0], q[1], q[2]) - p).norm());
+  }
+  return best;
 }
 
 }  // namespace remesh::test

@@ -16,4 +16,7 @@ void scale_mean_edge(TriMesh& mesh, double mean);
 /// Fraction of edges with length in [lo, hi].
 double plain_inside_fraction(const TriMesh& mesh, double lo, double hi);
 
+/// Distance from p to the nearest triangle of the mesh, by brute force over every face.
+double brute_distance(const TriMesh& mesh, const Vec3& p);
+
 }  // namespace remesh::test
