@@ -14,6 +14,7 @@
 #include "remesh/fold_guard.h"
 #include "remesh/interval_cleanup.h"
 #include "remesh/low_pass_filter.h"
+#include "remesh/mesh_snapshot.h"
 #include "remesh/priority_list.h"
 #include "remesh/projection.h"
 #include "remesh/reference_surface.h"
@@ -66,7 +67,9 @@ bool plateaued(const std::vector<double>& history) {
 }
 
 /// Iterations without a new low of edges outside the interval (cleanup on) before a run stops as
-/// stalled.
+/// stalled. A stalled run returns the mesh of its low (the fewest edges outside; among those, the
+/// most regular vertices): the count wanders by a few edges around it (cow: 1 edge at iteration 28,
+/// 2 at the stall at 34; cheese: 121 at 26, 143 at 32).
 constexpr int kStallSpan = 6;
 
 /// Polishing: after the first iteration with every edge inside, iterations go on while they raise
@@ -139,10 +142,11 @@ Result equalize(TriMesh& mesh, const Params& params, const OnIteration& on_itera
   int fewest_at = 0;
   // Polishing (see kPolishMax): when it began, and the best mesh so far with every edge inside.
   struct Converged {
-    TriMesh mesh;
+    MeshSnapshot mesh;
     IterationStats row;
   };
   std::optional<Converged> best;
+  std::optional<Converged> fewest;  // the mesh of the low of edges outside, once the cleanup runs
   int converged_at = 0, outside_since = 0;  // first convergence; iterations in a row with edges outside
   std::vector<IterationStats> held;  // rows of the polishing iterations, not yet reported
   auto flush = [&] {
@@ -229,10 +233,17 @@ Result equalize(TriMesh& mesh, const Params& params, const OnIteration& on_itera
     const bool all_inside = row.small == 0 && row.big == 0;
     Outcome outcome = Outcome::Completed;
     bool restore = false;
-    if (cleanup_started && row.small + row.big < fewest_outside) fewest_outside = row.small + row.big, fewest_at = i;
+    const std::size_t outside = row.small + row.big;
+    if (cleanup_started && outside < fewest_outside) fewest_outside = outside, fewest_at = i;
+    // Keep the mesh of the low while no edge is inside yet (a converged run returns `best`).
+    if (cleanup_started && !all_inside && !best && !params.run_all_iterations && params.cleanup &&
+        outside == fewest_outside &&
+        (!fewest || fewest->row.small + fewest->row.big > outside ||
+         row.regular_percent > fewest->row.regular_percent))
+      fewest = Converged{MeshSnapshot(mesh), row};
     if (!params.run_all_iterations && params.cleanup) {
       if (all_inside && !best) {
-        best = Converged{mesh, row};
+        best = Converged{MeshSnapshot(mesh), row};
         converged_at = i;
       } else if (best) {
         const bool gained = all_inside && row.regular_percent >= best->row.regular_percent + kPolishGain;
@@ -244,17 +255,26 @@ Result equalize(TriMesh& mesh, const Params& params, const OnIteration& on_itera
           outcome = Outcome::Converged;
           restore = !all_inside;
         } else if (gained) {
-          best = Converged{mesh, row};
+          best = Converged{MeshSnapshot(mesh), row};
           flush();  // the rows before this one stand
         }
       } else if (i - fewest_at >= kStallSpan && cleanup_started) {
         outcome = Outcome::Stalled;
       }
+      // A run that ends with edges outside (stalled, or n reached) returns the mesh of its low; this
+      // iteration's row describes it (its counters stay this iteration's), so that the last row is
+      // the returned mesh's.
+      const std::size_t low = fewest ? fewest->row.small + fewest->row.big : SIZE_MAX;
+      if (!best && (outcome == Outcome::Stalled || i == params.iterations) &&
+          (low < outside || (low == outside && fewest->row.regular_percent > row.regular_percent))) {
+        mesh = fewest->mesh.rebuild();
+        row = measured_row(mesh, params, row);
+      }
     } else if (!params.run_all_iterations && all_inside) {
       outcome = Outcome::Converged;
     }
     if (restore) {
-      mesh = std::move(best->mesh);
+      mesh = best->mesh.rebuild();
       row = best->row;
       held.clear();
     }

@@ -2,8 +2,11 @@
 // cancellation, determinism.
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <stop_token>
+#include <utility>
 #include <vector>
 
 #include "remesh/equalize.h"
@@ -190,6 +193,33 @@ TEST_CASE("convergence stops early unless all iterations are asked for", "[equal
   const Result r2 = equalize(again, all);
   CHECK(r2.outcome == Outcome::Completed);
   CHECK(r2.iterations_done == 12);
+}
+
+TEST_CASE("a stalled run returns the mesh with the fewest edges outside", "[equalize]") {
+  // Tori whose tube (diameter 1.0 and 1.2) is too thin for every edge to reach [1.2, 1.8]: the count
+  // of edges outside stops falling and wanders around its low.
+  for (const auto& [R, r] : {std::pair{5.0, 0.6}, std::pair{8.0, 0.5}}) {
+    TriMesh mesh = test::make_torus(static_cast<int>(8 * R), 12, R, r);
+    std::vector<IterationStats> rows;
+    const Topology before = topology(mesh);
+    const Result result = equalize(mesh, table_4_2(100), [&](const IterationStats& s) { rows.push_back(s); });
+    REQUIRE(result.outcome == Outcome::Stalled);
+    REQUIRE(!rows.empty());
+    CHECK(test::check_mesh_valid(mesh) == "");
+    CHECK(topology(mesh) == before);
+    // The last row describes the returned mesh ...
+    const std::size_t outside = rows.back().small + rows.back().big;
+    const double inside = test::plain_inside_fraction(mesh, 1.2, 1.8);
+    CHECK(outside == static_cast<std::size_t>(std::lround((1.0 - inside) * static_cast<double>(mesh.n_edges()))));
+    CHECK(rows.back().vertices == mesh.n_vertices());
+    // ... which has no more edges outside than any mesh since the cleanup began.
+    std::size_t first_cleanup = 0;
+    while (first_cleanup < rows.size() && rows[first_cleanup].cleanup_fixes == 0) ++first_cleanup;
+    REQUIRE(first_cleanup + 1 < rows.size());
+    std::size_t low = SIZE_MAX;
+    for (std::size_t i = first_cleanup; i + 1 < rows.size(); ++i) low = std::min(low, rows[i].small + rows[i].big);
+    CHECK(outside <= low);
+  }
 }
 
 TEST_CASE("the same input gives bit-identical output with 1 and 2 threads", "[equalize]") {

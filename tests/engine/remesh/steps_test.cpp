@@ -1,13 +1,16 @@
 // Each step of Algorithm 1 alone.
 #include <catch2/catch.hpp>
 
+#include <array>
 #include <cmath>
 #include <random>
+#include <vector>
 
 #include "remesh/geometry.h"
 #include "remesh/feature_snap.h"
 #include "remesh/interval_cleanup.h"
 #include "remesh/low_pass_filter.h"
+#include "remesh/mesh_snapshot.h"
 #include "remesh/projection.h"
 #include "remesh/reference_surface.h"
 #include "remesh/reposition.h"
@@ -422,5 +425,41 @@ TEST_CASE("feature snap brings a sharp tip nearer without taking edges out or pu
     for (auto v : mesh.vertices())
       if (mesh.point(v) != before.point(v))
         CHECK((surface.closest_point(mesh.point(v)) - mesh.point(v)).norm() < 1e-9);
+  }
+}
+
+TEST_CASE("a mesh snapshot rebuilds the live vertices and faces in their order", "[steps]") {
+  TriMesh mesh = test::make_torus(20, 10, 3.0, 1.0);
+  // Delete a few elements without garbage collection, as a run leaves them between steps.
+  int collapsed = 0;
+  for (auto h : mesh.halfedges())
+    if (collapsed < 5 && !mesh.status(h).deleted() && mesh.is_collapse_ok(h)) mesh.collapse(h), ++collapsed;
+  REQUIRE(collapsed == 5);
+  std::vector<Vec3> points;
+  for (auto v : mesh.vertices())
+    if (!mesh.status(v).deleted()) points.push_back(mesh.point(v));
+  std::vector<std::array<Vec3, 3>> faces;
+  for (auto f : mesh.faces()) {
+    if (mesh.status(f).deleted()) continue;
+    OpenMesh::VertexHandle c[3];
+    geom::face_vertices(mesh, f, c);
+    faces.push_back({mesh.point(c[0]), mesh.point(c[1]), mesh.point(c[2])});
+  }
+  const TriMesh rebuilt = MeshSnapshot(mesh).rebuild();
+  CHECK(test::check_mesh_valid(rebuilt) == "");
+  CHECK(test::euler_characteristic(rebuilt) == 0);
+  REQUIRE(rebuilt.n_vertices() == points.size());
+  REQUIRE(rebuilt.n_faces() == faces.size());
+  for (std::size_t i = 0; i < points.size(); ++i)
+    CHECK(rebuilt.point(rebuilt.vertex_handle(static_cast<unsigned>(i))) == points[i]);
+  for (std::size_t i = 0; i < faces.size(); ++i) {
+    OpenMesh::VertexHandle c[3];
+    geom::face_vertices(rebuilt, rebuilt.face_handle(static_cast<unsigned>(i)), c);
+    // The same corners in the same cyclic order (the orientation), from whichever corner.
+    int same = 0;
+    for (int r = 0; r < 3; ++r)
+      same += rebuilt.point(c[r]) == faces[i][0] && rebuilt.point(c[(r + 1) % 3]) == faces[i][1] &&
+              rebuilt.point(c[(r + 2) % 3]) == faces[i][2];
+    CHECK(same == 1);
   }
 }
