@@ -69,7 +69,9 @@ bool plateaued(const std::vector<double>& history) {
 /// Iterations without a new low of edges outside the interval (cleanup on) before a run stops as
 /// stalled. A stalled run returns the mesh of its low (the fewest edges outside; among those, the
 /// most regular vertices): the count wanders by a few edges around it (cow: 1 edge at iteration 28,
-/// 2 at the stall at 34; cheese: 121 at 26, 143 at 32).
+/// 2 at the stall at 34; cheese: 121 at 26, 143 at 32). Measured (Table 4.2 setup): a span of 4
+/// saves 2-8 iterations but ends bunny's simplification at 99.59 % inside and 80.4 % regular
+/// (6: 99.86 and 85.9 %), cheese's at 62.6 % (63.7 %).
 constexpr int kStallSpan = 6;
 
 /// Polishing: after the first iteration with every edge inside, iterations go on while they raise

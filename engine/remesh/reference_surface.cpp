@@ -280,8 +280,10 @@ Vec3 ReferenceSurface::Impl::closest_point(const Vec3& p, const Vec3& normal_hin
 /// hint, so a walk never turns round a fold of the reference onto another sheet.
 void ReferenceSurface::Impl::walk(const Vec3& p, const Vec3& normal_hint, std::uint32_t& t, Vec3& c,
                                   double& d2) const {
-  constexpr int kWalkSteps = 16;
-  constexpr double kWalkCos = 0.9;  // about 25 degrees
+  constexpr int kWalkSteps = 16;  // a descent: each step strictly closer; the bound caps its cost
+  // About 25 degrees. Measured (Table 4.2 setup): 45 degrees changes nothing on nefertiti, cow and
+  // camelhead, and ends cheese at 99.18 % inside instead of 99.24 %.
+  constexpr double kWalkCos = 0.9;
   const bool use_hint = normal_hint.sqrnorm() > 0;
   for (int step = 0; step < kWalkSteps; ++step) {
     std::uint32_t next = kNone;
