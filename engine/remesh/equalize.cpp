@@ -237,7 +237,7 @@ Result equalize(TriMesh& mesh, const Params& params, const OnIteration& on_itera
     bool restore = false;
     const std::size_t outside = row.small + row.big;
     if (cleanup_started && outside < fewest_outside) fewest_outside = outside, fewest_at = i;
-    // Keep the mesh of the low while no edge is inside yet (a converged run returns `best`).
+    // Keep the mesh of the low until the first mesh with every edge inside (then `best` is returned).
     if (cleanup_started && !all_inside && !best && !params.run_all_iterations && params.cleanup &&
         outside == fewest_outside &&
         (!fewest || fewest->row.small + fewest->row.big > outside ||
@@ -247,6 +247,7 @@ Result equalize(TriMesh& mesh, const Params& params, const OnIteration& on_itera
       if (all_inside && !best) {
         best = Converged{MeshSnapshot(mesh), row};
         converged_at = i;
+        fewest.reset();  // no longer needed
       } else if (best) {
         const bool gained = all_inside && row.regular_percent >= best->row.regular_percent + kPolishGain;
         outside_since = all_inside ? 0 : outside_since + 1;

@@ -145,7 +145,8 @@ ReferenceSurface::ReferenceSurface(const TriMesh& mesh, std::size_t neighbours)
     for (std::size_t t = 0; t < nt; ++t)
       for (auto v : m.triangles[t]) m.vertex_triangles.items[fill[v]++] = static_cast<std::uint32_t>(t);
   }
-  // Triangles across each edge: match the two halves of every edge through the lower end's list.
+  // Triangles across each edge: the reversed edge (b, a) among the triangles at a; none when the
+  // edge is a boundary or has more than two triangles.
   m.across.assign(nt, {Impl::kNone, Impl::kNone, Impl::kNone});
   for (std::size_t t = 0; t < nt; ++t)
     for (int k = 0; k < 3; ++k) {
@@ -165,7 +166,9 @@ ReferenceSurface::ReferenceSurface(const TriMesh& mesh, std::size_t neighbours)
   // folded back onto it: a defect of the input (nefertiti has 96 such pairs: slivers that close
   // T-junctions of its base with their third corner on the wrong side). Its normal is noise, and a
   // vertex that follows it into the fold gets squeezed between the sheets. The neighbours cover the
-  // same place, so the projection ignores it.
+  // same place, so the projection ignores it. A genuine blade sharper than 18 degrees would lose the
+  // row of smaller triangles along its edge the same way (none among the shared meshes; the rule
+  // does not check that the larger triangle covers the smaller one).
   constexpr double kFoldCos = -0.95;
   m.folded.assign(nt, 0);
   for (std::size_t t = 0; t < nt; ++t)
@@ -227,7 +230,8 @@ Vec3 ReferenceSurface::closest_point(const Vec3& p, const Vec3& normal_hint, Nei
   return impl_->closest_point(p, normal_hint, idx, found);
 }
 
-/// The closest point to p on the triangles incident to the reference vertices idx[0..found).
+/// The closest point to p on the triangles incident to the reference vertices idx[0..found) (folded
+/// ones skipped), improved by walk().
 Vec3 ReferenceSurface::Impl::closest_point(const Vec3& p, const Vec3& normal_hint, const std::uint32_t* idx,
                                            std::size_t found) const {
   const Impl& m = *this;
@@ -262,12 +266,14 @@ Vec3 ReferenceSurface::Impl::closest_point(const Vec3& p, const Vec3& normal_hin
   // "Nearly as close": within twice the distance of the closest candidate (plus a hair for points
   // already on the surface).
   if (use_hint && agree_t != kNone) {
+    // Walked before the comparison: a large triangle the candidates missed can bring the vertex's
+    // own sheet nearer.
+    walk(p, normal_hint, agree_t, best_agree, agree_d2);
     const double scale = 1e-12 * (1.0 + p.sqrnorm());
-    if (agree_d2 <= 4.0 * best_d2 + scale) {
-      walk(p, normal_hint, agree_t, best_agree, agree_d2);
-      return best_agree;
-    }
+    if (agree_d2 <= 4.0 * best_d2 + scale) return best_agree;
   }
+  // With a hint, the closest candidate here disagrees with it, and the walk only enters agreeing
+  // triangles: it moves only where that candidate is nearly parallel to the hint.
   if (best_t != kNone) walk(p, normal_hint, best_t, best, best_d2);
   return best;
 }
