@@ -44,8 +44,7 @@ struct ReferenceSurface::Impl {
   std::vector<Vec3> centres;        ///< per triangle: centroid
   std::vector<double> radii;        ///< per triangle: largest distance centroid -> corner
   Csr vertex_triangles;             ///< triangles incident to each vertex
-  /// per triangle: the triangle across its edge (corner k, corner k+1), or kNone (boundary or
-  /// non-manifold edge)
+  /// per triangle: the triangle across its edge (corner k, corner k+1), or kNone (boundary edge)
   std::vector<std::array<std::uint32_t, 3>> across;
   static constexpr std::uint32_t kNone = UINT32_MAX;
   /// per triangle: folded back onto a larger neighbour (see kFoldCos); never a candidate
@@ -112,12 +111,28 @@ ReferenceSurface::ReferenceSurface(const TriMesh& mesh, std::size_t neighbours)
     index[v.idx()] = static_cast<std::uint32_t>(m.points.size());
     m.points.push_back(mesh.point(v));
   }
+  std::vector<std::uint32_t> face_index(mesh.n_faces(), Impl::kNone);
   for (auto f : mesh.faces()) {
     if (mesh.status(f).deleted()) continue;
+    face_index[f.idx()] = static_cast<std::uint32_t>(m.triangles.size());
     OpenMesh::VertexHandle c[3];
     geom::face_vertices(mesh, f, c);
     std::array<std::uint32_t, 3> t{index[c[0].idx()], index[c[1].idx()], index[c[2].idx()]};
     m.triangles.push_back(t);
+  }
+  // Triangles across each edge, from the mesh's halfedges: corners c0, c1, c2 are the ends of
+  // h, next(h), next(next(h)) (geom::face_vertices), so edge (c_k, c_k+1) is next^(k+1)(h).
+  m.across.reserve(m.triangles.size());
+  for (auto f : mesh.faces()) {
+    if (mesh.status(f).deleted()) continue;
+    std::array<std::uint32_t, 3> across{Impl::kNone, Impl::kNone, Impl::kNone};
+    auto h = mesh.halfedge_handle(f);
+    for (int k = 0; k < 3; ++k) {
+      h = mesh.next_halfedge_handle(h);
+      const auto g = mesh.opposite_face_handle(h);
+      if (g.is_valid()) across[k] = face_index[g.idx()];
+    }
+    m.across.push_back(across);
   }
   if (m.triangles.empty()) throw MeshError("reference surface has no triangles");
   const std::size_t nv = m.points.size(), nt = m.triangles.size();
@@ -145,23 +160,6 @@ ReferenceSurface::ReferenceSurface(const TriMesh& mesh, std::size_t neighbours)
     for (std::size_t t = 0; t < nt; ++t)
       for (auto v : m.triangles[t]) m.vertex_triangles.items[fill[v]++] = static_cast<std::uint32_t>(t);
   }
-  // Triangles across each edge: the reversed edge (b, a) among the triangles at a; none when the
-  // edge is a boundary or has more than two triangles.
-  m.across.assign(nt, {Impl::kNone, Impl::kNone, Impl::kNone});
-  for (std::size_t t = 0; t < nt; ++t)
-    for (int k = 0; k < 3; ++k) {
-      const std::uint32_t a = m.triangles[t][k], b = m.triangles[t][(k + 1) % 3];
-      std::uint32_t other = Impl::kNone;
-      int count = 0;
-      for (std::uint32_t j = m.vertex_triangles.offsets[a]; j < m.vertex_triangles.offsets[a + 1]; ++j) {
-        const std::uint32_t u = m.vertex_triangles.items[j];
-        if (u == t) continue;
-        const auto& tri = m.triangles[u];
-        for (int l = 0; l < 3; ++l)
-          if (tri[l] == b && tri[(l + 1) % 3] == a) other = u, ++count;
-      }
-      if (count == 1) m.across[t][k] = other;
-    }
   // A triangle whose normal is nearly opposite to that of a larger neighbour across an edge lies
   // folded back onto it: a defect of the input (nefertiti has 96 such pairs: slivers that close
   // T-junctions of its base with their third corner on the wrong side). Its normal is noise, and a
