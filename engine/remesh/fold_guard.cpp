@@ -23,26 +23,41 @@ std::size_t undo_folds(TriMesh& mesh, const std::vector<Vec3>& before, unsigned 
     return geom::cross_normal(before[c[0].idx()], before[c[1].idx()], before[c[2].idx()]);
   };
   // Folded: turned by more than 90 degrees, or folded onto a neighbour (kMinAdjacentCos);
-  // degenerate: a minimum angle below kMinAngle that it did not have before.
-  auto face_is_bad = [&](OpenMesh::FaceHandle f) {
+  // degenerate: a minimum angle below kMinAngle that it did not have before. The normals come from
+  // `n_before(g)` and `n_now(g)`: tables in the first, parallel pass over every face (each normal
+  // computed once, not once per neighbour), computed afresh after restores.
+  auto face_is_bad = [&](OpenMesh::FaceHandle f, const auto& n_before, const auto& n_now) {
     if (mesh.status(f).deleted()) return false;
     OpenMesh::VertexHandle c[3];
     geom::face_vertices(mesh, f, c);
     const Vec3 &a0 = before[c[0].idx()], &b0 = before[c[1].idx()], &c0 = before[c[2].idx()];
     const Vec3 &a1 = mesh.point(c[0]), &b1 = mesh.point(c[1]), &c1 = mesh.point(c[2]);
     if (a0 == a1 && b0 == b1 && c0 == c1) return false;
-    const Vec3 n0 = geom::cross_normal(a0, b0, c0), n1 = geom::cross_normal(a1, b1, c1);
+    const Vec3 n0 = n_before(f), n1 = n_now(f);
     if (!geom::normals_agree(n0, n1, 0.0)) return true;
     const double floor_angle = std::min(geom::kMinAngle, geom::min_angle(a0, b0, c0));
     if (geom::min_angle(a1, b1, c1) < floor_angle) return true;
     for (auto h : mesh.fh_range(f)) {
       const auto g = mesh.opposite_face_handle(h);
       if (!g.is_valid()) continue;
-      if (!geom::adjacent_ok(n0, normal_before(g), n1, geom::face_normal(mesh, g))) return true;
+      if (!geom::adjacent_ok(n0, n_before(g), n1, n_now(g))) return true;
     }
     return false;
   };
-  parallel_for(nf, threads, [&](std::size_t i) { bad[i] = face_is_bad(mesh.face_handle(static_cast<unsigned>(i))); });
+  {
+    std::vector<Vec3> was(nf), now(nf);
+    parallel_for(nf, threads, [&](std::size_t i) {
+      const auto f = mesh.face_handle(static_cast<unsigned>(i));
+      if (mesh.status(f).deleted()) return;
+      was[i] = normal_before(f);
+      now[i] = geom::face_normal(mesh, f);
+    });
+    auto table = [](const std::vector<Vec3>& t) { return [&t](OpenMesh::FaceHandle f) { return t[f.idx()]; }; };
+    parallel_for(nf, threads, [&](std::size_t i) {
+      bad[i] = face_is_bad(mesh.face_handle(static_cast<unsigned>(i)), table(was), table(now));
+    });
+  }
+  auto fresh_now = [&](OpenMesh::FaceHandle f) { return geom::face_normal(mesh, f); };
   std::vector<OpenMesh::FaceHandle> queue;
   for (std::size_t i = 0; i < nf; ++i)
     if (bad[i]) queue.push_back(mesh.face_handle(static_cast<unsigned>(i)));
@@ -63,7 +78,7 @@ std::size_t undo_folds(TriMesh& mesh, const std::vector<Vec3>& before, unsigned 
     queue.clear();
     for (auto v : moved)
       for (auto f : mesh.vf_range(v))
-        if (face_is_bad(f)) queue.push_back(f);
+        if (face_is_bad(f, normal_before, fresh_now)) queue.push_back(f);
   }
   return restored;
 }

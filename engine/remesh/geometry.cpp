@@ -91,10 +91,24 @@ Vec3 vertex_normal(const TriMesh& mesh, OpenMesh::VertexHandle v) {
   return len > 0 ? n / len : Vec3(0, 0, 0);
 }
 
+std::vector<Vec3> face_normals(const TriMesh& mesh, unsigned threads) {
+  std::vector<Vec3> normals(mesh.n_faces(), Vec3(0, 0, 0));
+  parallel_for(mesh.n_faces(), threads, [&](std::size_t i) {
+    const auto f = mesh.face_handle(static_cast<unsigned>(i));
+    if (!mesh.status(f).deleted()) normals[i] = face_normal(mesh, f);
+  });
+  return normals;
+}
+
 std::vector<Vec3> vertex_normals(const TriMesh& mesh, unsigned threads) {
+  // Each face's normal once (not once per corner); summed in vertex_normal's order, so the same bits.
+  const std::vector<Vec3> faces = face_normals(mesh, threads);
   std::vector<Vec3> normals(mesh.n_vertices(), Vec3(0, 0, 0));
   parallel_for(mesh.n_vertices(), threads, [&](std::size_t i) {
-    normals[i] = vertex_normal(mesh, mesh.vertex_handle(static_cast<unsigned>(i)));
+    Vec3 n(0, 0, 0);
+    for (auto f : mesh.vf_range(mesh.vertex_handle(static_cast<unsigned>(i)))) n += faces[f.idx()];
+    const double len = n.norm();
+    normals[i] = len > 0 ? n / len : Vec3(0, 0, 0);
   });
   return normals;
 }

@@ -50,6 +50,9 @@ Vec3 face_normal(const TriMesh& mesh, OpenMesh::FaceHandle f);
 /// Area-weighted unit normal of vertex v (zero for an isolated vertex or a degenerate star).
 Vec3 vertex_normal(const TriMesh& mesh, OpenMesh::VertexHandle v);
 
+/// face_normal() of every face, one per face index (zero for deleted faces). Parallel.
+std::vector<Vec3> face_normals(const TriMesh& mesh, unsigned threads);
+
 /// vertex_normal() of every vertex, one per vertex index. Parallel.
 std::vector<Vec3> vertex_normals(const TriMesh& mesh, unsigned threads);
 
