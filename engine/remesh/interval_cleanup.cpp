@@ -279,14 +279,16 @@ class Cleanup {
     const Vec3 tangent = boundary ? boundary_tangent(v) : Vec3(0, 0, 0);
     if (boundary && tangent.sqrnorm() == 0) return false;
     const Vec3 start = mesh_.point(v);
+    // Progress: fewer star edges outside, or as many but closer to the interval (a strictly
+    // decreasing measure, so rounds cannot cycle). A vertex with its whole star inside cannot
+    // progress, so it is not settled and projected in vain (cheese: 23 000 of 130 000 attempts).
+    const auto [n_before, e_before] = outside_around(v, start);
+    if (n_before == 0) return false;
     const Vec3 n = geom::vertex_normal(mesh_, v);
     std::vector<Vec3> ring;
     for (auto w : mesh_.vv_range(v)) ring.push_back(mesh_.point(w));
     const Vec3 x = settle(start, ring, n, tangent);
     const Vec3 p = project_vertex(mesh_, v, x, n, reference_);
-    // Progress: fewer star edges outside, or as many but closer to the interval (a strictly
-    // decreasing measure, so rounds cannot cycle).
-    const auto [n_before, e_before] = outside_around(v, start);
     const auto [n_after, e_after] = outside_around(v, p);
     if (n_after > n_before || (n_after == n_before && !(e_after < 0.9 * e_before))) return false;
     if (!geom::move_is_safe(mesh_, v, p)) return false;
