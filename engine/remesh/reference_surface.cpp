@@ -272,8 +272,8 @@ Vec3 ReferenceSurface::Impl::closest_point(const Vec3& p, const Vec3& normal_hin
         const double reach = m.radii[t] + bound;
         if (from_centre.sqrnorm() > reach * reach) continue;
         // ... or whose plane is: a sliver's bounding sphere is wide (cheese.off: triangles 3.6 by
-        // 0.17 around its holes, where this test halves the cleanup's time). The margin keeps the
-        // test conservative against rounding.
+        // 0.17 around its holes; this test makes its run 15 % faster). The margin keeps the test
+        // conservative against rounding.
         if (std::abs(m.unit_normals[t] | from_centre) > bound * (1.0 + 1e-9) + 1e-12) continue;
       }
       const auto& tri = m.triangles[t];

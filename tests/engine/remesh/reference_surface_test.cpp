@@ -75,3 +75,41 @@ TEST_CASE("projection ignores a triangle folded back onto a larger neighbour", "
     CHECK(std::abs((c - p).norm() - brute_distance(m, p)) < 1e-12);
   }
 }
+
+TEST_CASE("projection's pruning is exact on slivers: with every vertex a candidate it finds the closest point",
+          "[reference]") {
+  // A closed prism of 12 sides, radius 1 and height 6, capped by fans: its side triangles are
+  // slivers 6 long and 0.5 wide, whose bounding spheres (radius 3) prune nothing, so the pruning by
+  // vertex reach and by plane distance decides (cheese.off's holes). With 26 vertices, fewer than
+  // the 30 nearest of Alg. 6, every triangle is a candidate and the answer must be the exact one,
+  // from inside, outside, beside the caps and far away.
+  TriMesh m;
+  constexpr int kSides = 12;
+  std::vector<OpenMesh::VertexHandle> bottom, top;
+  for (int i = 0; i < kSides; ++i) {
+    const double a = 2 * M_PI * i / kSides;
+    bottom.push_back(m.add_vertex(Vec3(std::cos(a), std::sin(a), 0)));
+    top.push_back(m.add_vertex(Vec3(std::cos(a), std::sin(a), 6)));
+  }
+  const auto low = m.add_vertex(Vec3(0, 0, 0)), high = m.add_vertex(Vec3(0, 0, 6));
+  for (int i = 0; i < kSides; ++i) {
+    const int j = (i + 1) % kSides;
+    m.add_face(bottom[i], bottom[j], top[j]);
+    m.add_face(bottom[i], top[j], top[i]);
+    m.add_face(low, bottom[j], bottom[i]);
+    m.add_face(high, top[i], top[j]);
+  }
+  REQUIRE(m.n_vertices() == 26);
+  const ReferenceSurface reference(m);
+  int checked = 0;
+  for (double r : {0.0, 0.3, 0.9, 1.05, 1.5, 4.0})
+    for (double z : {-2.0, -0.1, 0.2, 3.0, 5.9, 6.5, 9.0})
+      for (int k = 0; k < 7; ++k) {
+        const double a = 0.37 + 0.9 * k;  // angles between the vertices
+        const Vec3 p(r * std::cos(a), r * std::sin(a), z);
+        const Vec3 c = reference.closest_point(p);
+        CHECK(std::abs((c - p).norm() - brute_distance(m, p)) < 1e-12);
+        ++checked;
+      }
+  CHECK(checked == 6 * 7 * 7);
+}
