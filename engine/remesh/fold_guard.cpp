@@ -45,13 +45,12 @@ std::size_t undo_folds(TriMesh& mesh, const std::vector<Vec3>& before, unsigned 
     return false;
   };
   {
-    std::vector<Vec3> was(nf), now(nf);
+    std::vector<Vec3> was(nf);
     parallel_for(nf, threads, [&](std::size_t i) {
       const auto f = mesh.face_handle(static_cast<unsigned>(i));
-      if (mesh.status(f).deleted()) return;
-      was[i] = normal_before(f);
-      now[i] = geom::face_normal(mesh, f);
+      if (!mesh.status(f).deleted()) was[i] = normal_before(f);
     });
+    const std::vector<Vec3> now = geom::face_normals(mesh, threads);
     auto table = [](const std::vector<Vec3>& t) { return [&t](OpenMesh::FaceHandle f) { return t[f.idx()]; }; };
     parallel_for(nf, threads, [&](std::size_t i) {
       bad[i] = face_is_bad(mesh.face_handle(static_cast<unsigned>(i)), table(was), table(now));

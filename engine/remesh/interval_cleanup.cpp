@@ -285,7 +285,8 @@ class Cleanup {
     const auto [n_before, e_before] = outside_around(v, start);
     if (n_before == 0) return false;
     const Vec3 n = geom::vertex_normal(mesh_, v);
-    std::vector<Vec3> ring;
+    std::vector<Vec3>& ring = ring_;
+    ring.clear();
     for (auto w : mesh_.vv_range(v)) ring.push_back(mesh_.point(w));
     const Vec3 x = settle(start, ring, n, tangent);
     const Vec3 p = project_vertex(mesh_, v, x, n, reference_);
@@ -383,7 +384,7 @@ class Cleanup {
     for (auto v : patch) saved.push_back(mesh_.point(v));
     bool ok = !pinned.is_valid() || geom::move_is_safe(mesh_, pinned, pin_at);
     if (ok && pinned.is_valid()) mesh_.point(pinned) = pin_at;
-    std::vector<Vec3> ring;
+    std::vector<Vec3>& ring = ring_;
     // Each vertex moves a little per sweep: its kd-tree answer is mostly reusable (reference_surface.h).
     patch_caches_.assign(patch.size(), NeighbourCache{});
     // A sweep in which no vertex moved ends the relaxation (the next would not move any either).
@@ -446,6 +447,7 @@ class Cleanup {
   ComponentSizes sizes_;
   bool collapsed_ = false;              ///< deleted elements to collect (finish)
   bool collapsed_since_round_ = false;  ///< a collapse in the current round
+  std::vector<Vec3> ring_;        ///< a vertex's 1-ring points, for relocate and relax_patch (reused buffer)
   std::vector<char> patch_mark_;  ///< try_relax_patch's membership flags, all zero between calls
   std::vector<NeighbourCache> patch_caches_;  ///< relax_patch's kd-tree answers, one per patch vertex
   std::vector<int> failed_patches_;           ///< edges whose patch relaxation failed (patch_failed)
