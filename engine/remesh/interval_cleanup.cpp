@@ -125,6 +125,8 @@ class Cleanup {
     return fixes;
   }
 
+  void set_patch_budget(std::size_t budget) { patch_budget_ = budget; }
+
   /// Collects what the collapses deleted. Once, after the last round: between rounds the deleted
   /// elements are skipped, and collecting (which renumbers, so the component sizes had to be
   /// recounted) took a third of the cleanup's time on armadillo_86k.
@@ -451,8 +453,7 @@ class Cleanup {
   std::vector<char> patch_mark_;  ///< try_relax_patch's membership flags, all zero between calls
   std::vector<NeighbourCache> patch_caches_;  ///< relax_patch's kd-tree answers, one per patch vertex
   std::vector<int> failed_patches_;           ///< edges whose patch relaxation failed (patch_failed)
-  /// Patch relaxations left in this cleanup (each costs a few hundred projections): enough for
-  /// the few stubborn edges of a nearly converged mesh, not for thousands in a rough one.
+  /// Patch relaxations left in this cleanup (interval_cleanup's `patch_budget`).
   std::size_t patch_budget_ = std::max<std::size_t>(64, mesh_.n_edges() / 1000);
 };
 
@@ -469,8 +470,9 @@ std::size_t snap_to_features(TriMesh& mesh, const ReferenceSurface& reference, d
 }
 
 CleanupCounts interval_cleanup(TriMesh& mesh, const ReferenceSurface& reference, double e_min, double e_max,
-                               double flip_factor, int rounds, bool boundary_only) {
+                               double flip_factor, int rounds, bool boundary_only, std::size_t patch_budget) {
   Cleanup cleanup(mesh, reference, e_min, e_max, flip_factor);
+  if (patch_budget > 0) cleanup.set_patch_budget(patch_budget);
   CleanupCounts counts;
   counts.outside_before = cleanup.count_outside();
   if (counts.outside_before > 0)
