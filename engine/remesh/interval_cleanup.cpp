@@ -72,8 +72,9 @@ class GapJudge {
 
 class Cleanup {
  public:
-  Cleanup(TriMesh& mesh, const ReferenceSurface& reference, double e_min, double e_max, double f)
-      : mesh_(mesh), reference_(reference), e_min_(e_min), e_max_(e_max), f_(f), sizes_(mesh) {}
+  Cleanup(TriMesh& mesh, const ReferenceSurface& reference, double e_min, double e_max, double f,
+          std::vector<NeighbourCache>* caches = nullptr)
+      : mesh_(mesh), reference_(reference), e_min_(e_min), e_max_(e_max), f_(f), sizes_(mesh), caches_(caches) {}
 
   bool inside(double length) const { return length >= e_min_ && length <= e_max_; }
   double outside_by(double length) const { return std::max({0.0, e_min_ - length, length - e_max_}); }
@@ -127,6 +128,10 @@ class Cleanup {
 
   void set_patch_budget(std::size_t budget) { patch_budget_ = budget; }
 
+  NeighbourCache* cache_of(VertexHandle v) {
+    return caches_ && static_cast<std::size_t>(v.idx()) < caches_->size() ? &(*caches_)[v.idx()] : nullptr;
+  }
+
   /// Collects what the collapses deleted. Once, after the last round: between rounds the deleted
   /// elements are skipped, and collecting (which renumbers, so the component sizes had to be
   /// recounted) took a third of the cleanup's time on armadillo_86k.
@@ -166,7 +171,7 @@ class Cleanup {
     Vec3 p = plan.position;
     if (free_placement) p = settle(p, collapse_neighbours(mesh_, plan.halfedge), normal);
     if (!mesh_.is_boundary(kept) || mesh_.is_boundary(mesh_.edge_handle(plan.halfedge)))
-      p = project_vertex(mesh_, kept, p, normal, reference_);
+      p = project_vertex(mesh_, kept, p, normal, reference_, cache_of(kept));
     if (!collapse_geometry_ok(mesh_, plan.halfedge, p, e_max_)) return false;
     for (VertexHandle end : {kept, removed})
       for (auto w : mesh_.vv_range(end))
@@ -291,7 +296,7 @@ class Cleanup {
     ring.clear();
     for (auto w : mesh_.vv_range(v)) ring.push_back(mesh_.point(w));
     const Vec3 x = settle(start, ring, n, tangent);
-    const Vec3 p = project_vertex(mesh_, v, x, n, reference_);
+    const Vec3 p = project_vertex(mesh_, v, x, n, reference_, cache_of(v));
     const auto [n_after, e_after] = outside_around(v, p);
     if (n_after > n_before || (n_after == n_before && !(e_after < 0.9 * e_before))) return false;
     if (!geom::move_is_safe(mesh_, v, p)) return false;
@@ -388,7 +393,7 @@ class Cleanup {
     if (ok && pinned.is_valid()) mesh_.point(pinned) = pin_at;
     std::vector<Vec3>& ring = ring_;
     // Each vertex moves a little per sweep: its kd-tree answer is mostly reusable (reference_surface.h).
-    patch_caches_.assign(patch.size(), NeighbourCache{});
+    if (!caches_) patch_caches_.assign(patch.size(), NeighbourCache{});
     // A sweep in which no vertex moved ends the relaxation (the next would not move any either).
     for (int sweep = 0, moved = 1; ok && moved && sweep < kPatchSweeps; ++sweep) {
       moved = 0;
@@ -400,7 +405,8 @@ class Cleanup {
         const Vec3 n = geom::vertex_normal(mesh_, v);
         const Vec3 x = settle(mesh_.point(v), ring, n);
         if (x == mesh_.point(v)) continue;  // its edges are well inside: settle leaves it, so does the projection
-        const Vec3 p = project_vertex(mesh_, v, x, n, reference_, &patch_caches_[i]);
+        NeighbourCache* cache = caches_ ? cache_of(v) : &patch_caches_[i];
+        const Vec3 p = project_vertex(mesh_, v, x, n, reference_, cache);
         if (geom::move_is_safe(mesh_, v, p)) mesh_.point(v) = p, moved = 1;
       }
     }
@@ -431,7 +437,7 @@ class Cleanup {
       if (budget == 0) break;
       --budget;
       // Projected like every other vertex move (the normal keeps it on its own sheet).
-      const Vec3 partial = project_vertex(mesh_, v, from + s * (move.target - from), n, reference_);
+      const Vec3 partial = project_vertex(mesh_, v, from + s * (move.target - from), n, reference_, cache_of(v));
       if (relax_patch({v}, v, partial, true, &judge)) return true;
     }
     return false;
@@ -452,6 +458,10 @@ class Cleanup {
   std::vector<Vec3> ring_;        ///< a vertex's 1-ring points, for relocate and relax_patch (reused buffer)
   std::vector<char> patch_mark_;  ///< try_relax_patch's membership flags, all zero between calls
   std::vector<NeighbourCache> patch_caches_;  ///< relax_patch's kd-tree answers, one per patch vertex
+  /// The iterations' kd-tree answers, one per vertex index (projection.h), when the caller keeps
+  /// them: a relocated vertex has moved little since its projection, so its answer is mostly
+  /// reusable. Indices from splits are beyond it (no cache).
+  std::vector<NeighbourCache>* caches_;
   std::vector<int> failed_patches_;           ///< edges whose patch relaxation failed (patch_failed)
   /// Patch relaxations left in this cleanup (interval_cleanup's `patch_budget`).
   std::size_t patch_budget_ = std::max<std::size_t>(64, mesh_.n_edges() / 1000);
@@ -470,8 +480,9 @@ std::size_t snap_to_features(TriMesh& mesh, const ReferenceSurface& reference, d
 }
 
 CleanupCounts interval_cleanup(TriMesh& mesh, const ReferenceSurface& reference, double e_min, double e_max,
-                               double flip_factor, int rounds, bool boundary_only, std::size_t patch_budget) {
-  Cleanup cleanup(mesh, reference, e_min, e_max, flip_factor);
+                               double flip_factor, int rounds, bool boundary_only, std::size_t patch_budget,
+                               std::vector<NeighbourCache>* caches) {
+  Cleanup cleanup(mesh, reference, e_min, e_max, flip_factor, caches);
   if (patch_budget > 0) cleanup.set_patch_budget(patch_budget);
   CleanupCounts counts;
   counts.outside_before = cleanup.count_outside();

@@ -39,10 +39,11 @@ struct CleanupCounts {
 /// split/collapse alone cannot even out a boundary whose edges are, say, 1.1 m long).
 /// `patch_budget` caps the patch relaxations (fix 4's stronger form, a few hundred projections
 /// each); 0 means max(64, edges / 1000), enough for the few stubborn edges of a nearly converged
-/// mesh, not for thousands in a rough one.
+/// mesh, not for thousands in a rough one. `caches`: the projection's per-vertex kd-tree answers
+/// (projection.h), reused and refreshed by the cleanup's projections (exact either way).
 CleanupCounts interval_cleanup(TriMesh& mesh, const ReferenceSurface& reference, double e_min, double e_max,
                                double flip_factor, int rounds = 4, bool boundary_only = false,
-                               std::size_t patch_budget = 0);
+                               std::size_t patch_budget = 0, std::vector<NeighbourCache>* caches = nullptr);
 
 /// A move of the feature snap (feature_snap.h): vertex v onto target, a point of the reference.
 /// With `partial`, when the whole move is refused, fractions of it are tried in turn (for the
