@@ -19,10 +19,15 @@ using OpenMesh::VertexHandle;
 
 namespace {
 
-/// The feature snap's guard for the Hausdorff distance: the snap's target and the reference points
-/// that lie within e_min of a patch's faces (the ones a relaxation of the patch could pull away
-/// from) may not end up farther from those faces than the farthest of them was before. Points
-/// farther from the patch are closer to faces it does not move, so their distance cannot grow.
+/// The feature snap's guard for the Hausdorff distance. Judged: the snap's target and the reference
+/// points within e_min of the patch's faces (the ones a relaxation of the patch could pull away
+/// from). A move is kept only if it brings the target nearer to the faces and no other judged
+/// point ends farther from them than it was or than the target now is. A point whose nearest face
+/// lies outside the patch keeps that face (it does not move), so no point's distance to the mesh
+/// grows beyond that bound: the largest distance around the patch falls. (A bound shared by all
+/// points, the farthest of their distances before, let a point whose nearest face is elsewhere
+/// lift the bound to nearly e_min: on kitten a partial snap then pushed a reference vertex from
+/// 0.68 to 0.86 units off the mesh.)
 class GapJudge {
  public:
   /// `reach`: a distance from the target beyond which no point is within e_min of the faces.
@@ -34,14 +39,15 @@ class GapJudge {
       if (q != target && (q - target).sqrnorm() < reach * reach) consider(mesh, q, e_min);
   }
 
-  /// Does every judged point lie within the limit of the (moved) faces?
+  /// Is the target nearer to the (moved) faces, and every other judged point within its bound?
   bool holds(const TriMesh& mesh) const {
-    for (std::size_t k = 0; k < points_.size(); ++k) {
+    const double target = nearest_distance(mesh, points_[0]);
+    if (!(target < before_[0])) return false;
+    for (std::size_t k = 1; k < points_.size(); ++k) {
+      const double limit = std::max(before_[k], before_[0]);
       // The face that was nearest usually still is: its distance bounds the point's from above.
-      if (distance(mesh, points_[k], nearest_[k]) <= limit_) continue;
-      double d = std::numeric_limits<double>::max();
-      for (auto f : faces_) d = std::min(d, distance(mesh, points_[k], f));
-      if (d > limit_) return false;
+      if (distance(mesh, points_[k], nearest_[k]) <= limit) continue;
+      if (nearest_distance(mesh, points_[k]) > limit) return false;
     }
     return true;
   }
@@ -53,6 +59,12 @@ class GapJudge {
     return (geom::closest_point_on_triangle(q, a, b, c) - q).norm();
   }
 
+  double nearest_distance(const TriMesh& mesh, const Vec3& q) const {
+    double d = std::numeric_limits<double>::max();
+    for (auto f : faces_) d = std::min(d, distance(mesh, q, f));
+    return d;
+  }
+
   void consider(const TriMesh& mesh, const Vec3& q, double within) {
     double d = std::numeric_limits<double>::max();
     OpenMesh::FaceHandle nearest;
@@ -61,13 +73,13 @@ class GapJudge {
     if (d >= within) return;
     points_.push_back(q);
     nearest_.push_back(nearest);
-    limit_ = std::max(limit_, d);
+    before_.push_back(d);
   }
 
   std::vector<OpenMesh::FaceHandle> faces_;
-  std::vector<Vec3> points_;
+  std::vector<Vec3> points_;  ///< the target first
   std::vector<OpenMesh::FaceHandle> nearest_;
-  double limit_ = 0;
+  std::vector<double> before_;  ///< each point's distance to the faces before the move
 };
 
 class Cleanup {
@@ -447,7 +459,9 @@ class Cleanup {
   static constexpr std::size_t kPatchRings = 2;
   static constexpr int kPatchSweeps = 6;
   /// When the vertex cannot reach the feature point, the fractions of the way to it tried in turn.
-  static constexpr double kPartialSnaps[] = {0.85, 0.7, 0.55, 0.4, 0.25};
+  /// Measured (Table 4.2 setup, Hausdorff % of the bbox diagonal): 15 and 8 % after 25 % bring
+  /// nefertiti 0.198 -> 0.185 (CGAL 0.193); with them the guard had to become per point (kitten).
+  static constexpr double kPartialSnaps[] = {0.85, 0.7, 0.55, 0.4, 0.25, 0.15, 0.08};
 
   TriMesh& mesh_;
   const ReferenceSurface& reference_;
