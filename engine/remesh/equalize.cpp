@@ -73,7 +73,7 @@ bool plateaued(const std::vector<double>& history) {
 /// kFewOutside of the edges: a few edges pinned by the input's geometry, which more iterations do
 /// not win (the final cleanup does what can be done). Measured (Table 4.2 setup): a span of 3
 /// instead of 6 gives the same meshes on every refinement run that stalls (cow, cheese, nefertiti,
-/// camelhead, bunny_zipper; 2-3 iterations less, nefertiti 10.8 -> 9.1 s), but ends the
+/// camelhead, bunny_zipper; 2-3 iterations less, nefertiti 10.8 -> 9.0 s), but ends the
 /// simplifications, which creep down by a few edges every 3-6 iterations, early: bunny 99.95 ->
 /// 99.59 % inside and 85.9 -> 80.4 % regular, cow 95.5 -> 93.4 %, camelhead 99.73 -> 99.56 %.
 /// The share rule keeps 6 for those (bunny's low is 0.15 % of its edges until its last iterations).
@@ -250,7 +250,7 @@ Result equalize(TriMesh& mesh, const Params& params, const OnIteration& on_itera
     // Is this the last iteration? Converged: every edge inside; with the cleanup on, after the
     // polishing iterations (kPolishMax), returning the polished mesh with the most regular vertices.
     // Stalled: with the cleanup on, the count of edges outside has not reached a new low for
-    // kStallSpan iterations (a few edges pinned by the input's geometry, e.g. where two sheets
+    // stall_span() iterations (a few edges pinned by the input's geometry, e.g. where two sheets
     // touch): more iterations would change nothing but the time spent.
     const bool all_inside = row.small == 0 && row.big == 0;
     Outcome outcome = Outcome::Completed;
@@ -297,9 +297,14 @@ Result equalize(TriMesh& mesh, const Params& params, const OnIteration& on_itera
         const CleanupCounts c = interval_cleanup(mesh, *reference, params.e_min, params.e_max, params.flip_factor,
                                                  kFinalCleanupRounds, false, final_patch_budget(mesh),
                                                  &neighbour_caches);
-        if (c.outside_before > c.outside_after) {
-          row.cleanup_fixes += c.flips + c.collapses + c.splits + c.relocations + c.patches;
+        const std::size_t fixes = c.flips + c.collapses + c.splits + c.relocations + c.patches;
+        if (fixes > 0) {
+          row.cleanup_fixes += fixes;
+          row.splits += c.splits;
+          row.collapses += c.collapses;
+          row.flips += c.flips;
           row = measured_row(mesh, params, row);
+          if (c.outside_after == 0 && outcome == Outcome::Stalled) outcome = Outcome::Converged;
         }
       }
     } else if (!params.run_all_iterations && all_inside) {

@@ -22,10 +22,10 @@ namespace {
 /// The feature snap's guard for the Hausdorff distance. Judged: the snap's target and the reference
 /// points within e_min of the patch's faces (the ones a relaxation of the patch could pull away
 /// from). A move is kept only if it brings the target nearer to the faces and no other judged
-/// point ends farther from them than it was or than the target now is. A point whose nearest face
+/// point ends farther from them than it was or than the target was. A point whose nearest face
 /// lies outside the patch keeps that face (it does not move), so no point's distance to the mesh
-/// grows beyond that bound: the largest distance around the patch falls. (A bound shared by all
-/// points, the farthest of their distances before, let a point whose nearest face is elsewhere
+/// grows beyond the larger of its own and the target's distance before the move. (A bound shared by
+/// all points, the farthest of their distances before, let a point whose nearest face is elsewhere
 /// lift the bound to nearly e_min: on kitten a partial snap then pushed a reference vertex from
 /// 0.68 to 0.86 units off the mesh.)
 class GapJudge {
@@ -33,18 +33,18 @@ class GapJudge {
   /// `reach`: a distance from the target beyond which no point is within e_min of the faces.
   GapJudge(const TriMesh& mesh, std::vector<OpenMesh::FaceHandle> faces, const Vec3& target,
            const std::vector<Vec3>& points, double e_min, double reach)
-      : faces_(std::move(faces)) {
-    consider(mesh, target, std::numeric_limits<double>::max());  // the point to bring in, however far
+      : faces_(std::move(faces)), target_(target) {
+    target_before_ = nearest_distance(mesh, target);
     for (const Vec3& q : points)
       if (q != target && (q - target).sqrnorm() < reach * reach) consider(mesh, q, e_min);
   }
 
   /// Is the target nearer to the (moved) faces, and every other judged point within its bound?
+  /// (Never with no faces: nothing can come nearer.)
   bool holds(const TriMesh& mesh) const {
-    const double target = nearest_distance(mesh, points_[0]);
-    if (!(target < before_[0])) return false;
-    for (std::size_t k = 1; k < points_.size(); ++k) {
-      const double limit = std::max(before_[k], before_[0]);
+    if (!(nearest_distance(mesh, target_) < target_before_)) return false;
+    for (std::size_t k = 0; k < points_.size(); ++k) {
+      const double limit = std::max(before_[k], target_before_);
       // The face that was nearest usually still is: its distance bounds the point's from above.
       if (distance(mesh, points_[k], nearest_[k]) <= limit) continue;
       if (nearest_distance(mesh, points_[k]) > limit) return false;
@@ -59,25 +59,28 @@ class GapJudge {
     return (geom::closest_point_on_triangle(q, a, b, c) - q).norm();
   }
 
+  /// Distance from q to the nearest face (infinity with none).
   double nearest_distance(const TriMesh& mesh, const Vec3& q) const {
-    double d = std::numeric_limits<double>::max();
+    double d = std::numeric_limits<double>::infinity();
     for (auto f : faces_) d = std::min(d, distance(mesh, q, f));
     return d;
   }
 
   void consider(const TriMesh& mesh, const Vec3& q, double within) {
-    double d = std::numeric_limits<double>::max();
+    double d = std::numeric_limits<double>::infinity();
     OpenMesh::FaceHandle nearest;
     for (auto f : faces_)
       if (const double x = distance(mesh, q, f); x < d) d = x, nearest = f;
-    if (d >= within) return;
+    if (!(d < within)) return;
     points_.push_back(q);
     nearest_.push_back(nearest);
     before_.push_back(d);
   }
 
   std::vector<OpenMesh::FaceHandle> faces_;
-  std::vector<Vec3> points_;  ///< the target first
+  Vec3 target_;
+  double target_before_ = 0;  ///< the target's distance to the faces before the move
+  std::vector<Vec3> points_;  ///< the other judged points
   std::vector<OpenMesh::FaceHandle> nearest_;
   std::vector<double> before_;  ///< each point's distance to the faces before the move
 };
@@ -474,7 +477,8 @@ class Cleanup {
   std::vector<NeighbourCache> patch_caches_;  ///< relax_patch's kd-tree answers, one per patch vertex
   /// The iterations' kd-tree answers, one per vertex index (projection.h), when the caller keeps
   /// them: a relocated vertex has moved little since its projection, so its answer is mostly
-  /// reusable. Indices from splits are beyond it (no cache).
+  /// reusable. A vertex without a slot (a split's, beyond the vector) goes without; a slot left from
+  /// another vertex (after a renumbering) still gives an exact answer (reference_surface.h).
   std::vector<NeighbourCache>* caches_;
   std::vector<int> failed_patches_;           ///< edges whose patch relaxation failed (patch_failed)
   /// Patch relaxations left in this cleanup (interval_cleanup's `patch_budget`).

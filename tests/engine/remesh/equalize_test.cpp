@@ -212,6 +212,10 @@ TEST_CASE("a stalled run returns the mesh with the fewest edges outside", "[equa
     const double inside = test::plain_inside_fraction(mesh, 1.2, 1.8);
     CHECK(outside == static_cast<std::size_t>(std::lround((1.0 - inside) * static_cast<double>(mesh.n_edges()))));
     CHECK(rows.back().vertices == mesh.n_vertices());
+    CHECK(rows.back().edges == mesh.n_edges());
+    double sum = 0;
+    for (auto e : mesh.edges()) sum += mesh.calc_edge_length(e);
+    CHECK(rows.back().mean == Approx(sum / static_cast<double>(mesh.n_edges())).epsilon(1e-12));
     // ... which has no more edges outside than any mesh since the cleanup began.
     std::size_t first_cleanup = 0;
     while (first_cleanup < rows.size() && rows[first_cleanup].cleanup_fixes == 0) ++first_cleanup;
