@@ -287,24 +287,26 @@ Result equalize(TriMesh& mesh, const Params& params, const OnIteration& on_itera
       // A run that ends with edges outside (stalled, or n reached) returns the mesh of its low; this
       // iteration's row describes it (its counters stay this iteration's), so that the last row is
       // the returned mesh's.
-      const std::size_t low = fewest ? fewest->row.small + fewest->row.big : SIZE_MAX;
-      if (!best && (outcome == Outcome::Stalled || i == params.iterations) &&
-          (low < outside || (low == outside && fewest->row.regular_percent > row.regular_percent))) {
-        mesh = fewest->mesh.rebuild();
-        row = measured_row(mesh, params, row);
-      }
-      if (!best && (outcome == Outcome::Stalled || i == params.iterations) && !stop.stop_requested()) {
-        const CleanupCounts c = interval_cleanup(mesh, *reference, params.e_min, params.e_max, params.flip_factor,
-                                                 kFinalCleanupRounds, false, final_patch_budget(mesh),
-                                                 &neighbour_caches);
-        const std::size_t fixes = c.flips + c.collapses + c.splits + c.relocations + c.patches;
-        if (fixes > 0) {
-          row.cleanup_fixes += fixes;
-          row.splits += c.splits;
-          row.collapses += c.collapses;
-          row.flips += c.flips;
+      // Then the final cleanup (kFinalCleanupRounds) works on it.
+      if (!best && (outcome == Outcome::Stalled || i == params.iterations)) {
+        const std::size_t low = fewest ? fewest->row.small + fewest->row.big : SIZE_MAX;
+        if (low < outside || (low == outside && fewest->row.regular_percent > row.regular_percent)) {
+          mesh = fewest->mesh.rebuild();
           row = measured_row(mesh, params, row);
-          if (c.outside_after == 0 && outcome == Outcome::Stalled) outcome = Outcome::Converged;
+        }
+        if (!stop.stop_requested()) {
+          const CleanupCounts c = interval_cleanup(mesh, *reference, params.e_min, params.e_max, params.flip_factor,
+                                                   kFinalCleanupRounds, false, final_patch_budget(mesh),
+                                                   &neighbour_caches);
+          const std::size_t fixes = c.flips + c.collapses + c.splits + c.relocations + c.patches;
+          if (fixes > 0) {
+            row.cleanup_fixes += fixes;
+            row.splits += c.splits;
+            row.collapses += c.collapses;
+            row.flips += c.flips;
+            row = measured_row(mesh, params, row);
+            if (c.outside_after == 0 && outcome == Outcome::Stalled) outcome = Outcome::Converged;
+          }
         }
       }
     } else if (!params.run_all_iterations && all_inside) {

@@ -59,21 +59,20 @@ class GapJudge {
     return (geom::closest_point_on_triangle(q, a, b, c) - q).norm();
   }
 
-  /// Distance from q to the nearest face (infinity with none).
-  double nearest_distance(const TriMesh& mesh, const Vec3& q) const {
-    double d = std::numeric_limits<double>::infinity();
-    for (auto f : faces_) d = std::min(d, distance(mesh, q, f));
-    return d;
+  /// Distance from q to the nearest face (infinity with none), and that face.
+  std::pair<double, OpenMesh::FaceHandle> nearest(const TriMesh& mesh, const Vec3& q) const {
+    std::pair<double, OpenMesh::FaceHandle> best{std::numeric_limits<double>::infinity(), {}};
+    for (auto f : faces_)
+      if (const double x = distance(mesh, q, f); x < best.first) best = {x, f};
+    return best;
   }
+  double nearest_distance(const TriMesh& mesh, const Vec3& q) const { return nearest(mesh, q).first; }
 
   void consider(const TriMesh& mesh, const Vec3& q, double within) {
-    double d = std::numeric_limits<double>::infinity();
-    OpenMesh::FaceHandle nearest;
-    for (auto f : faces_)
-      if (const double x = distance(mesh, q, f); x < d) d = x, nearest = f;
+    const auto [d, face] = nearest(mesh, q);
     if (!(d < within)) return;
     points_.push_back(q);
-    nearest_.push_back(nearest);
+    nearest_.push_back(face);
     before_.push_back(d);
   }
 
@@ -381,7 +380,7 @@ class Cleanup {
   }
 
   /// Moves `pinned` (if valid) to `pin_at`, then relaxes the other interior vertices within
-  /// kPatchRings rings of `seeds` (which include `pinned`). Keeps the result if the patch's edges
+  /// kPatchRings rings of `patch` (which includes `pinned`). Keeps the result if the patch's edges
   /// outside the interval are fewer, or as many with 10 % less squared excess, or (with
   /// `allow_equal`) not more; else every vertex goes back.
   bool relax_patch(std::vector<VertexHandle> patch, VertexHandle pinned, const Vec3& pin_at, bool allow_equal,

@@ -56,9 +56,10 @@ struct SnapMove {
 
 /// Makes each move and relaxes the interior vertices within 2 rings of the moved vertex, as the
 /// patch relaxation does; keeps a move only if it folds nothing, leaves no more edges of the patch
-/// outside [e_min, e_max] than before, and leaves none of the `features` points near the patch
-/// farther from it than the farthest of them was. Each try (a patch relaxation) takes one from
-/// `budget`; none is made when it is 0. Returns the number of moves kept.
+/// outside [e_min, e_max] than before, brings its target nearer to the mesh, and leaves none of the
+/// `features` points near the patch farther from it than the larger of that point's and the
+/// target's distance before. Each try (a patch relaxation) takes one from `budget`; none is made
+/// when it is 0. Returns the number of moves kept.
 std::size_t snap_to_features(TriMesh& mesh, const ReferenceSurface& reference, double e_min, double e_max,
                              const std::vector<SnapMove>& moves, const std::vector<Vec3>& features,
                              std::size_t& budget);
