@@ -105,6 +105,16 @@ constexpr int kPolishMax = 3;
 constexpr double kPolishGain = 0.25;
 constexpr int kPolishGrace = 3;
 
+std::size_t fixes(const CleanupCounts& c) { return c.flips + c.collapses + c.splits + c.relocations + c.patches; }
+
+/// Adds a cleanup's fixes and its splits, collapses and flips to a row's counters.
+void count_cleanup(IterationStats& row, const CleanupCounts& c) {
+  row.cleanup_fixes += fixes(c);
+  row.splits += c.splits;
+  row.collapses += c.collapses;
+  row.flips += c.flips;
+}
+
 /// The statistics of `mesh` with the iteration number and operation counters of `counted`.
 IterationStats measured_row(const TriMesh& mesh, const Params& params, const IterationStats& counted) {
   IterationStats row = measure(mesh, params.e_min, params.e_max, params.threads);
@@ -236,12 +246,12 @@ Result equalize(TriMesh& mesh, const Params& params, const OnIteration& on_itera
                                              inside_fraction(mesh, params, threads) >= kCleanupFrom));
       const bool full = last || cleanup_started;
       if (full || reference->has_boundary()) {
-        const CleanupCounts c = interval_cleanup(mesh, *reference, params.e_min, params.e_max, params.flip_factor,
-                                                 kCleanupRounds, !full, 0, &neighbour_caches);
-        counters.cleanup_fixes = c.flips + c.collapses + c.splits + c.relocations + c.patches;
-        counters.splits += c.splits;
-        counters.collapses += c.collapses;
-        counters.flips += c.flips;
+        CleanupOptions options;
+        options.rounds = kCleanupRounds;
+        options.boundary_only = !full;
+        options.caches = &neighbour_caches;
+        count_cleanup(counters, interval_cleanup(mesh, *reference, params.e_min, params.e_max, params.flip_factor,
+                                                 options));
       }
     }
 
@@ -295,15 +305,14 @@ Result equalize(TriMesh& mesh, const Params& params, const OnIteration& on_itera
           row = measured_row(mesh, params, row);
         }
         if (!stop.stop_requested()) {
-          const CleanupCounts c = interval_cleanup(mesh, *reference, params.e_min, params.e_max, params.flip_factor,
-                                                   kFinalCleanupRounds, false, final_patch_budget(mesh),
-                                                   &neighbour_caches);
-          const std::size_t fixes = c.flips + c.collapses + c.splits + c.relocations + c.patches;
-          if (fixes > 0) {
-            row.cleanup_fixes += fixes;
-            row.splits += c.splits;
-            row.collapses += c.collapses;
-            row.flips += c.flips;
+          CleanupOptions options;
+          options.rounds = kFinalCleanupRounds;
+          options.patch_budget = final_patch_budget(mesh);
+          options.caches = &neighbour_caches;
+          const CleanupCounts c =
+              interval_cleanup(mesh, *reference, params.e_min, params.e_max, params.flip_factor, options);
+          if (fixes(c) > 0) {
+            count_cleanup(row, c);
             row = measured_row(mesh, params, row);
             if (c.outside_after == 0 && outcome == Outcome::Stalled) outcome = Outcome::Converged;
           }

@@ -61,7 +61,7 @@ class GapJudge {
 
   /// Distance from q to the nearest face (infinity with none), and that face.
   std::pair<double, OpenMesh::FaceHandle> nearest(const TriMesh& mesh, const Vec3& q) const {
-    std::pair<double, OpenMesh::FaceHandle> best{std::numeric_limits<double>::infinity(), {}};
+    std::pair<double, OpenMesh::FaceHandle> best{std::numeric_limits<double>::infinity(), OpenMesh::FaceHandle()};
     for (auto f : faces_)
       if (const double x = distance(mesh, q, f); x < best.first) best = {x, f};
     return best;
@@ -497,15 +497,14 @@ std::size_t snap_to_features(TriMesh& mesh, const ReferenceSurface& reference, d
 }
 
 CleanupCounts interval_cleanup(TriMesh& mesh, const ReferenceSurface& reference, double e_min, double e_max,
-                               double flip_factor, int rounds, bool boundary_only, std::size_t patch_budget,
-                               std::vector<NeighbourCache>* caches) {
-  Cleanup cleanup(mesh, reference, e_min, e_max, flip_factor, caches);
-  if (patch_budget > 0) cleanup.set_patch_budget(patch_budget);
+                               double flip_factor, const CleanupOptions& options) {
+  Cleanup cleanup(mesh, reference, e_min, e_max, flip_factor, options.caches);
+  if (options.patch_budget > 0) cleanup.set_patch_budget(options.patch_budget);
   CleanupCounts counts;
   counts.outside_before = cleanup.count_outside();
   if (counts.outside_before > 0)
-    for (int r = 0; r < rounds; ++r)
-      if (cleanup.round(counts, boundary_only) == 0) break;
+    for (int r = 0; r < options.rounds; ++r)
+      if (cleanup.round(counts, options.boundary_only) == 0) break;
   cleanup.finish();
   counts.outside_after = cleanup.count_outside();
   return counts;

@@ -32,18 +32,27 @@ struct CleanupCounts {
   std::size_t outside_before = 0, outside_after = 0;  ///< edges outside [e_min, e_max]
 };
 
+/// How one cleanup runs (equalize.cpp: a per-iteration and a final form).
+struct CleanupOptions {
+  /// Rounds at most; the cleanup stops earlier after a round that fixes nothing.
+  int rounds = 4;
+  /// Only edges with an end on the boundary are treated. On open meshes a cleanup of this form runs
+  /// every iteration, because boundary vertices never move in the filter and split/collapse alone
+  /// cannot even out a boundary whose edges are, say, 1.1 m long.
+  bool boundary_only = false;
+  /// Cap on the patch relaxations (fix 4's stronger form, a few hundred projections each); 0 means
+  /// max(64, edges / 1000), enough for the few stubborn edges of a nearly converged mesh, not for
+  /// thousands in a rough one.
+  std::size_t patch_budget = 0;
+  /// The projection's per-vertex kd-tree answers (projection.h), reused and refreshed by the
+  /// cleanup's projections (exact either way); may be null.
+  std::vector<NeighbourCache>* caches = nullptr;
+};
+
 /// Runs the cleanup. Precondition: no deleted elements (garbage-collected); it leaves the mesh
 /// garbage-collected too. `flip_factor` is Params::flip_factor.
-/// With `boundary_only`, only edges with an end on the boundary are treated (see equalize.cpp: on
-/// open meshes this runs every iteration, because boundary vertices never move in the filter and
-/// split/collapse alone cannot even out a boundary whose edges are, say, 1.1 m long).
-/// `patch_budget` caps the patch relaxations (fix 4's stronger form, a few hundred projections
-/// each); 0 means max(64, edges / 1000), enough for the few stubborn edges of a nearly converged
-/// mesh, not for thousands in a rough one. `caches`: the projection's per-vertex kd-tree answers
-/// (projection.h), reused and refreshed by the cleanup's projections (exact either way).
 CleanupCounts interval_cleanup(TriMesh& mesh, const ReferenceSurface& reference, double e_min, double e_max,
-                               double flip_factor, int rounds = 4, bool boundary_only = false,
-                               std::size_t patch_budget = 0, std::vector<NeighbourCache>* caches = nullptr);
+                               double flip_factor, const CleanupOptions& options = {});
 
 /// A move of the feature snap (feature_snap.h): vertex v onto target, a point of the reference.
 /// With `partial`, when the whole move is refused, fractions of it are tried in turn (for the
