@@ -17,12 +17,12 @@ class Regularizer {
 
   std::size_t sweep(RegularizeCounts& counts) {
     std::size_t done = 0;
-    for (auto e : mesh_.edges()) {
-      if (mesh_.is_boundary(e)) continue;
+    marks_.for_each_edge(mesh_, [&](EdgeHandle e) {
+      if (mesh_.is_boundary(e)) return;
       const Quad q = quad_of(mesh_, e);
-      if (!marks_.any(q)) continue;
+      if (!marks_.any(q)) return;
       const int gain = info_.gain(q);
-      if (gain < 0 || !allowed(e)) continue;
+      if (gain < 0 || !allowed(e)) return;
       if (gain > 0) {
         flip(e, q);
         touch(q);
@@ -30,7 +30,7 @@ class Regularizer {
       } else if (flip_pair(e, q)) {
         ++counts.pairs, ++done;
       }
-    }
+    });
     marks_.next_sweep();
     return done;
   }

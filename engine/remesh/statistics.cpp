@@ -1,6 +1,7 @@
 #include "remesh/statistics.h"
 
 #include <cmath>
+#include <vector>
 
 #include "core/parallel.h"
 #include "remesh/geometry.h"
@@ -82,14 +83,25 @@ IterationStats measure(const TriMesh& mesh, double e_min, double e_max, unsigned
   });
   for (const auto& s : blocks) total.sum_dev2 += s.sum_dev2;
 
+  // Vertices, interior vertices, regular ones: counted per block (integers: any order adds up the same).
+  struct VertexCounts {
+    std::size_t vertices = 0, interior = 0, regular = 0;
+  };
+  std::vector<VertexCounts> vertex_blocks(block_count(mesh.n_vertices(), kBlock));
+  parallel_blocks(mesh.n_vertices(), kBlock, threads, [&](std::size_t b, std::size_t e, std::size_t block) {
+    VertexCounts c;
+    for (std::size_t i = b; i < e; ++i) {
+      const auto v = mesh.vertex_handle(static_cast<unsigned>(i));
+      if (mesh.status(v).deleted()) continue;
+      ++c.vertices;
+      if (mesh.is_boundary(v)) continue;  // includes isolated vertices
+      ++c.interior;
+      if (mesh.valence(v) == 6) ++c.regular;
+    }
+    vertex_blocks[block] = c;
+  });
   std::size_t interior = 0, regular = 0, vertices = 0;
-  for (auto v : mesh.vertices()) {
-    if (mesh.status(v).deleted()) continue;
-    ++vertices;
-    if (mesh.is_boundary(v)) continue;  // includes isolated vertices
-    ++interior;
-    if (mesh.valence(v) == 6) ++regular;
-  }
+  for (const VertexCounts& c : vertex_blocks) vertices += c.vertices, interior += c.interior, regular += c.regular;
   row.vertices = vertices;
   row.edges = total.count;
   row.mean = mean;

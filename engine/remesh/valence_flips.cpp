@@ -62,22 +62,46 @@ bool flip_improves(const TriMesh& mesh, EdgeHandle e, double f) {
   return VertexInfo(mesh).improves(quad_of(mesh, e)) && flip_is_safe(mesh, e, f);
 }
 
+void SweepMarks::next_sweep() {
+  for (auto v : was_touched_) previous_[v.idx()] = 0;
+  if (first_) std::fill(previous_.begin(), previous_.end(), 0);
+  first_ = false;
+  for (auto v : touched_) previous_[v.idx()] = 1, current_[v.idx()] = 0;
+  was_touched_.swap(touched_);
+  touched_.clear();
+}
+
+void SweepMarks::offer_edges_around(const TriMesh& mesh, VertexHandle v, int after) {
+  auto offer = [&](EdgeHandle e) {
+    if (e.idx() > after) pending_[e.idx() / 64] |= std::uint64_t{1} << (e.idx() % 64);
+  };
+  for (auto h : mesh.voh_range(v)) {
+    offer(mesh.edge_handle(h));
+    if (!mesh.is_boundary(h)) offer(mesh.edge_handle(mesh.next_halfedge_handle(h)));
+  }
+}
+
 namespace {
 
 /// One sweep over the interior edges in index order; with `marks`, only those it says may have
 /// changed.
 std::size_t sweep(TriMesh& mesh, double f, VertexInfo& info, SweepMarks* marks) {
   std::size_t flips = 0;
-  for (auto e : mesh.edges()) {
-    if (mesh.is_boundary(e)) continue;
+  auto visit = [&](EdgeHandle e) {
+    if (mesh.is_boundary(e)) return;
     const Quad q = quad_of(mesh, e);
-    if (marks && !marks->any(q)) continue;
-    if (!info.improves(q) || !flip_is_safe(mesh, e, f)) continue;
+    if (marks && !marks->any(q)) return;
+    if (!info.improves(q) || !flip_is_safe(mesh, e, f)) return;
     mesh.flip(e);
     info.flipped(q);
     if (marks)
       for (auto v : {q.v0, q.v1, q.v2, q.v3}) marks->touch(v);
     ++flips;
+  };
+  if (marks) {
+    marks->for_each_edge(mesh, visit);
+  } else {
+    for (auto e : mesh.edges()) visit(e);
   }
   return flips;
 }
