@@ -88,7 +88,7 @@ class Cleanup {
  public:
   Cleanup(TriMesh& mesh, const ReferenceSurface& reference, double e_min, double e_max, double f,
           std::vector<NeighbourCache>* caches = nullptr)
-      : mesh_(mesh), reference_(reference), e_min_(e_min), e_max_(e_max), f_(f), sizes_(mesh), caches_(caches) {}
+      : mesh_(mesh), reference_(reference), e_min_(e_min), e_max_(e_max), f_(f), caches_(caches) {}
 
   bool inside(double length) const { return length >= e_min_ && length <= e_max_; }
   double outside_by(double length) const { return std::max({0.0, e_min_ - length, length - e_max_}); }
@@ -147,8 +147,8 @@ class Cleanup {
   }
 
   /// Collects what the collapses deleted. Once, after the last round: between rounds the deleted
-  /// elements are skipped, and collecting (which renumbers, so the component sizes had to be
-  /// recounted) took a third of the cleanup's time on armadillo_86k.
+  /// elements are skipped, and collecting (which renumbers every element) after every round took a
+  /// third of the cleanup's time on armadillo_86k.
   void finish() {
     if (collapsed_) mesh_.garbage_collection();
     collapsed_ = false;
@@ -176,7 +176,7 @@ class Cleanup {
 
   bool collapse_at(EdgeHandle e, double plan_limit, bool free_placement) {
     CollapsePlan plan;
-    if (!plan_collapse(mesh_, e, target(), plan_limit, sizes_, plan)) return false;
+    if (!plan_collapse(mesh_, e, target(), plan_limit, plan)) return false;
     const VertexHandle kept = mesh_.to_vertex_handle(plan.halfedge);
     const VertexHandle removed = mesh_.from_vertex_handle(plan.halfedge);
     const bool on_boundary = mesh_.is_boundary(kept) || mesh_.is_boundary(removed);
@@ -191,7 +191,7 @@ class Cleanup {
       for (auto w : mesh_.vv_range(end))
         if (w != kept && w != removed && !inside((mesh_.point(w) - p).norm())) return false;
     plan.position = p;
-    apply_collapse(mesh_, plan, sizes_);
+    apply_collapse(mesh_, plan);
     collapsed_ = collapsed_since_round_ = true;
     return true;
   }
@@ -246,8 +246,7 @@ class Cleanup {
       p = project(settle(p0, around, normal, along));
       if (!split_point_fits(e, p, around)) return false;
     }
-    const VertexHandle v = mesh_.split(e, p);
-    sizes_.on_split(v, v0);
+    mesh_.split(e, p);
     return true;
   }
 
@@ -468,7 +467,6 @@ class Cleanup {
   TriMesh& mesh_;
   const ReferenceSurface& reference_;
   double e_min_, e_max_, f_;
-  ComponentSizes sizes_;
   bool collapsed_ = false;              ///< deleted elements to collect (finish)
   bool collapsed_since_round_ = false;  ///< a collapse in the current round
   std::vector<Vec3> ring_;        ///< a vertex's 1-ring points, for relocate and relax_patch (reused buffer)

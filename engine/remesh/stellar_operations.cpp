@@ -14,34 +14,16 @@ using OpenMesh::FaceHandle;
 using OpenMesh::HalfedgeHandle;
 using OpenMesh::VertexHandle;
 
-ComponentSizes::ComponentSizes(const TriMesh& mesh) : label_(mesh.n_vertices(), UINT32_MAX) {
-  std::vector<VertexHandle> stack;
-  for (auto seed : mesh.vertices()) {
-    if (mesh.status(seed).deleted() || label_[seed.idx()] != UINT32_MAX) continue;
-    const unsigned id = static_cast<unsigned>(sizes_.size());
-    sizes_.push_back(0);
-    label_[seed.idx()] = id;
-    stack.assign(1, seed);
-    while (!stack.empty()) {
-      const VertexHandle v = stack.back();
-      stack.pop_back();
-      ++sizes_[id];
-      for (auto w : mesh.vv_range(v)) {
-        if (label_[w.idx()] != UINT32_MAX) continue;
-        label_[w.idx()] = id;
-        stack.push_back(w);
-      }
+bool component_larger_than(const TriMesh& mesh, VertexHandle v, std::size_t n) {
+  std::vector<VertexHandle> seen{v};  // at most n + 1: a linear search is fine
+  for (std::size_t i = 0; i < seen.size(); ++i)
+    for (auto w : mesh.vv_range(seen[i])) {
+      if (std::find(seen.begin(), seen.end(), w) != seen.end()) continue;
+      seen.push_back(w);
+      if (seen.size() > n) return true;
     }
-  }
+  return false;
 }
-
-void ComponentSizes::on_split(VertexHandle new_vertex, VertexHandle neighbour) {
-  if (label_.size() <= static_cast<std::size_t>(new_vertex.idx())) label_.resize(new_vertex.idx() + 1, 0);
-  label_[new_vertex.idx()] = label_[neighbour.idx()];
-  ++sizes_[label_[neighbour.idx()]];
-}
-
-void ComponentSizes::on_collapse(VertexHandle removed) { --sizes_[label_[removed.idx()]]; }
 
 namespace {
 
@@ -70,7 +52,7 @@ bool boundary_loop_longer_than_3(const TriMesh& mesh, HalfedgeHandle h) {
 
 }  // namespace
 
-VertexHandle split_edge(TriMesh& mesh, EdgeHandle e, double target, ComponentSizes& sizes) {
+VertexHandle split_edge(TriMesh& mesh, EdgeHandle e, double target) {
   const HalfedgeHandle h = mesh.halfedge_handle(e, 0);
   const VertexHandle v0 = mesh.from_vertex_handle(h);
   const Vec3 a = mesh.point(v0), b = mesh.point(mesh.to_vertex_handle(h));
@@ -80,9 +62,7 @@ VertexHandle split_edge(TriMesh& mesh, EdgeHandle e, double target, ComponentSiz
     p = (a + b) * 0.5;
     if (!split_point_ok(mesh, e, p)) return VertexHandle();
   }
-  const VertexHandle v = mesh.split(e, p);
-  sizes.on_split(v, v0);
-  return v;
+  return mesh.split(e, p);
 }
 
 bool collapse_geometry_ok(const TriMesh& mesh, HalfedgeHandle h, const Vec3& p, double max_length) {
@@ -119,11 +99,10 @@ bool collapse_geometry_ok(const TriMesh& mesh, HalfedgeHandle h, const Vec3& p, 
   return true;
 }
 
-bool plan_collapse(const TriMesh& mesh, EdgeHandle e, double target, double max_length,
-                   const ComponentSizes& sizes, CollapsePlan& plan) {
+bool plan_collapse(const TriMesh& mesh, EdgeHandle e, double target, double max_length, CollapsePlan& plan) {
   HalfedgeHandle h = mesh.halfedge_handle(e, 0);
   VertexHandle v0 = mesh.from_vertex_handle(h), v1 = mesh.to_vertex_handle(h);
-  if (sizes.size_of(v0) <= 4) return false;
+  if (!component_larger_than(mesh, v0, 4)) return false;
   const bool b0 = mesh.is_boundary(v0), b1 = mesh.is_boundary(v1);
   Vec3 p;
   if (mesh.is_boundary(e)) {
@@ -148,11 +127,9 @@ bool plan_collapse(const TriMesh& mesh, EdgeHandle e, double target, double max_
   return true;
 }
 
-VertexHandle apply_collapse(TriMesh& mesh, const CollapsePlan& plan, ComponentSizes& sizes) {
-  const VertexHandle removed = mesh.from_vertex_handle(plan.halfedge);
+VertexHandle apply_collapse(TriMesh& mesh, const CollapsePlan& plan) {
   const VertexHandle kept = mesh.to_vertex_handle(plan.halfedge);
   mesh.collapse(plan.halfedge);
-  sizes.on_collapse(removed);
   mesh.point(kept) = plan.position;
   return kept;
 }
@@ -161,7 +138,6 @@ double collapse_length_limit(double m_i, double sigma) { return std::max(m_i + s
 
 StellarCounts stellar_operations(TriMesh& mesh, const std::vector<unsigned>& list, double m_i, double sigma) {
   StellarCounts counts;
-  ComponentSizes sizes(mesh);
   std::vector<char> visited(mesh.n_vertices(), 0);
   auto visit_star = [&](VertexHandle v) {
     if (visited.size() < mesh.n_vertices()) visited.resize(mesh.n_vertices(), 0);
@@ -176,14 +152,14 @@ StellarCounts stellar_operations(TriMesh& mesh, const std::vector<unsigned>& lis
     if (visited[v0.idx()] && visited[v1.idx()]) continue;
     const double length = mesh.calc_edge_length(e);
     if (length > m_i + sigma) {
-      const VertexHandle v = split_edge(mesh, e, m_i, sizes);
+      const VertexHandle v = split_edge(mesh, e, m_i);
       if (!v.is_valid()) continue;
       ++counts.splits;
       visit_star(v);
     } else if (length < m_i - sigma) {
       CollapsePlan plan;
-      if (!plan_collapse(mesh, e, m_i, collapse_length_limit(m_i, sigma), sizes, plan)) continue;
-      visit_star(apply_collapse(mesh, plan, sizes));
+      if (!plan_collapse(mesh, e, m_i, collapse_length_limit(m_i, sigma), plan)) continue;
+      visit_star(apply_collapse(mesh, plan));
       ++counts.collapses;
     }
   }

@@ -19,22 +19,13 @@
 
 namespace remesh {
 
-/// Live-vertex count of each connected component, kept current through splits and collapses.
-class ComponentSizes {
- public:
-  explicit ComponentSizes(const TriMesh& mesh);
-  std::size_t size_of(OpenMesh::VertexHandle v) const { return sizes_[label_[v.idx()]]; }
-  void on_split(OpenMesh::VertexHandle new_vertex, OpenMesh::VertexHandle neighbour);
-  void on_collapse(OpenMesh::VertexHandle removed);
-
- private:
-  std::vector<unsigned> label_;
-  std::vector<std::size_t> sizes_;
-};
+/// Does the connected component of v have more than n live vertices? A search from v that stops
+/// at the (n+1)-th vertex: a few steps for a small n, whatever the mesh's size.
+bool component_larger_than(const TriMesh& mesh, OpenMesh::VertexHandle v, std::size_t n);
 
 /// Splits edge e at the point of eq. 3.1 (target edge length `target`). Returns the new vertex, or
 /// an invalid handle when every candidate point would create a degenerate triangle.
-OpenMesh::VertexHandle split_edge(TriMesh& mesh, OpenMesh::EdgeHandle e, double target, ComponentSizes& sizes);
+OpenMesh::VertexHandle split_edge(TriMesh& mesh, OpenMesh::EdgeHandle e, double target);
 
 /// A planned collapse: the halfedge whose from-vertex goes away and where the kept vertex ends up.
 struct CollapsePlan {
@@ -45,14 +36,14 @@ struct CollapsePlan {
 /// Chooses direction and position (eq. 3.1, or the boundary vertex, see above) for collapsing e and
 /// checks every rule. Returns false when the collapse is not allowed.
 bool plan_collapse(const TriMesh& mesh, OpenMesh::EdgeHandle e, double target, double max_length,
-                   const ComponentSizes& sizes, CollapsePlan& plan);
+                   CollapsePlan& plan);
 
 /// Would collapsing `h` with the kept vertex at `p` fold or degenerate a triangle, or create an edge
 /// longer than max_length? (Geometric part of plan_collapse; topology is checked there.)
 bool collapse_geometry_ok(const TriMesh& mesh, OpenMesh::HalfedgeHandle h, const Vec3& p, double max_length);
 
 /// Carries out a plan; returns the kept vertex.
-OpenMesh::VertexHandle apply_collapse(TriMesh& mesh, const CollapsePlan& plan, ComponentSizes& sizes);
+OpenMesh::VertexHandle apply_collapse(TriMesh& mesh, const CollapsePlan& plan);
 
 /// The longest edge a collapse of Algorithm 3 may create: max(m_i + sigma, 2 (m_i - sigma)).
 /// ALGORITHM.md asks for m_i + sigma. Measured on spot.obj (Table 4.2 setup, 100 iterations) that

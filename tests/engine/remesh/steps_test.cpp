@@ -68,17 +68,16 @@ double two_face_min_angle(const TriMesh& m, EdgeHandle e) {
 TEST_CASE("splits and collapses keep the mesh valid and its topology", "[steps]") {
   TriMesh mesh = test::make_icosphere(3, 10.0);
   const long euler = test::euler_characteristic(mesh);
-  ComponentSizes sizes(mesh);
   std::size_t splits = 0, collapses = 0;
   for (unsigned i = 0; i < mesh.n_edges(); i += 7) {
-    if (split_edge(mesh, mesh.edge_handle(i), 1.0, sizes).is_valid()) ++splits;
+    if (split_edge(mesh, mesh.edge_handle(i), 1.0).is_valid()) ++splits;
   }
   for (unsigned i = 0; i < mesh.n_edges(); i += 5) {
     const EdgeHandle e = mesh.edge_handle(i);
     if (mesh.status(e).deleted()) continue;
     CollapsePlan plan;
-    if (plan_collapse(mesh, e, 1.0, 1e9, sizes, plan)) {
-      apply_collapse(mesh, plan, sizes);
+    if (plan_collapse(mesh, e, 1.0, 1e9, plan)) {
+      apply_collapse(mesh, plan);
       ++collapses;
     }
   }
@@ -92,7 +91,6 @@ TEST_CASE("splits and collapses keep the mesh valid and its topology", "[steps]"
 
 TEST_CASE("boundary collapses stay on the boundary and never pinch", "[steps]") {
   TriMesh mesh = test::make_open_grid(8, 8, 1.0);
-  ComponentSizes sizes(mesh);
   std::size_t boundary_collapses = 0;
   for (auto e : mesh.edges()) {
     if (mesh.status(e).deleted()) continue;
@@ -100,12 +98,12 @@ TEST_CASE("boundary collapses stay on the boundary and never pinch", "[steps]") 
     const auto v0 = mesh.from_vertex_handle(h), v1 = mesh.to_vertex_handle(h);
     CollapsePlan plan;
     if (!mesh.is_boundary(e) && mesh.is_boundary(v0) && mesh.is_boundary(v1)) {
-      CHECK_FALSE(plan_collapse(mesh, e, 1.0, 1e9, sizes, plan));
-    } else if (mesh.is_boundary(e) && plan_collapse(mesh, e, 1.0, 1e9, sizes, plan)) {
+      CHECK_FALSE(plan_collapse(mesh, e, 1.0, 1e9, plan));
+    } else if (mesh.is_boundary(e) && plan_collapse(mesh, e, 1.0, 1e9, plan)) {
       // The kept vertex lies on the collapsed boundary edge.
       const Vec3 a = mesh.point(v0), b = mesh.point(v1);
       CHECK(((plan.position - a) % (b - a)).norm() < 1e-9);
-      apply_collapse(mesh, plan, sizes);
+      apply_collapse(mesh, plan);
       ++boundary_collapses;
     }
   }
@@ -120,24 +118,51 @@ TEST_CASE("boundary collapses stay on the boundary and never pinch", "[steps]") 
 
 TEST_CASE("an interior edge between two boundary vertices is never collapsed", "[steps]") {
   TriMesh strip = test::make_open_grid(1, 6, 1.0);  // every vertex on the boundary
-  ComponentSizes sizes(strip);
   std::size_t interior = 0;
   for (auto e : strip.edges()) {
     if (strip.is_boundary(e)) continue;
     ++interior;
     CollapsePlan plan;
-    CHECK_FALSE(plan_collapse(strip, e, 10.0, 1e9, sizes, plan));
+    CHECK_FALSE(plan_collapse(strip, e, 10.0, 1e9, plan));
   }
   CHECK(interior >= 6);
 }
 
 TEST_CASE("a tetrahedron does not collapse away", "[steps]") {
   TriMesh mesh = tetrahedron();
-  ComponentSizes sizes(mesh);
   for (auto e : mesh.edges()) {
     CollapsePlan plan;
-    CHECK_FALSE(plan_collapse(mesh, e, 10.0, 1e9, sizes, plan));
+    CHECK_FALSE(plan_collapse(mesh, e, 10.0, 1e9, plan));
   }
+}
+
+TEST_CASE("a collapse is refused only in a component of 4 vertices or fewer", "[steps]") {
+  // A sphere and a tetrahedron in one mesh: the search from a vertex stays in its component.
+  TriMesh mesh = test::make_icosphere(2);
+  const TriMesh tetra = tetrahedron();
+  OpenMesh::VertexHandle t[4];
+  for (auto v : tetra.vertices()) t[v.idx()] = mesh.add_vertex(tetra.point(v) + Vec3(5, 0, 0));
+  for (auto f : tetra.faces()) {
+    std::vector<OpenMesh::VertexHandle> corners;
+    for (auto v : tetra.fv_range(f)) corners.push_back(t[v.idx()]);
+    mesh.add_face(corners);
+  }
+  const auto on_sphere = mesh.vertex_handle(0);
+  CHECK(component_larger_than(mesh, on_sphere, 4));
+  CHECK(component_larger_than(mesh, on_sphere, mesh.n_vertices() - 5));
+  CHECK_FALSE(component_larger_than(mesh, on_sphere, mesh.n_vertices() - 4));  // the sphere's own count
+  CHECK(component_larger_than(mesh, t[0], 3));
+  CHECK_FALSE(component_larger_than(mesh, t[0], 4));
+  std::size_t allowed_on_sphere = 0;
+  for (auto e : mesh.edges()) {
+    CollapsePlan plan;
+    const bool ok = plan_collapse(mesh, e, 10.0, 1e9, plan);
+    if (mesh.from_vertex_handle(mesh.halfedge_handle(e, 0)).idx() >= static_cast<int>(mesh.n_vertices()) - 4)
+      CHECK_FALSE(ok);
+    else
+      allowed_on_sphere += ok;
+  }
+  CHECK(allowed_on_sphere > 0);
 }
 
 TEST_CASE("eq. 3.1 places the vertex at the minimiser", "[steps]") {
@@ -301,9 +326,8 @@ TEST_CASE("the interval cleanup is safe, keeps vertices on the reference and is 
   TriMesh mesh = test::make_icosphere(3, 20.0);  // edge ~2.7: everything too long
   // Bring it near the interval [1.2, 1.8] without cleanup: split every edge once, then project.
   {
-    ComponentSizes sizes(mesh);
     const std::size_t n = mesh.n_edges();
-    for (unsigned i = 0; i < n; ++i) split_edge(mesh, mesh.edge_handle(i), 1.5, sizes);
+    for (unsigned i = 0; i < n; ++i) split_edge(mesh, mesh.edge_handle(i), 1.5);
     project_onto_reference(mesh, reference, 2);
   }
   auto outside = [](const TriMesh& m) {
