@@ -13,7 +13,8 @@ namespace {
 
 class Regularizer {
  public:
-  Regularizer(TriMesh& mesh, double f) : mesh_(mesh), info_(mesh), f_(f), marks_(mesh.n_vertices()) {}
+  Regularizer(TriMesh& mesh, double f, unsigned threads)
+      : mesh_(mesh), info_(mesh, threads), f_(f), marks_(mesh.n_vertices()) {}
 
   std::size_t sweep(RegularizeCounts& counts) {
     std::size_t done = 0;
@@ -82,9 +83,9 @@ class Regularizer {
 
 }  // namespace
 
-RegularizeCounts regularize(TriMesh& mesh, double f, int max_sweeps) {
+RegularizeCounts regularize(TriMesh& mesh, double f, int max_sweeps, unsigned threads) {
   RegularizeCounts counts;
-  Regularizer r(mesh, f);
+  Regularizer r(mesh, f, threads);
   for (int s = 0; s < max_sweeps; ++s)
     if (r.sweep(counts) == 0) break;
   return counts;

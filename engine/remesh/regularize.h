@@ -24,6 +24,7 @@ struct RegularizeCounts {
 };
 
 /// Sweeps over the interior edges (in index order) while they flip something, at most `max_sweeps`.
-RegularizeCounts regularize(TriMesh& mesh, double f, int max_sweeps = 4);
+/// `threads` count the valences; the sweeps are serial.
+RegularizeCounts regularize(TriMesh& mesh, double f, int max_sweeps = 4, unsigned threads = 1);
 
 }  // namespace remesh

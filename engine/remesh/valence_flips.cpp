@@ -4,6 +4,7 @@
 #include <cstdlib>
 #include <vector>
 
+#include "core/parallel.h"
 #include "remesh/geometry.h"
 
 namespace remesh {
@@ -18,11 +19,14 @@ Quad quad_of(const TriMesh& mesh, EdgeHandle e) {
           mesh.to_vertex_handle(mesh.next_halfedge_handle(h0)), mesh.to_vertex_handle(mesh.next_halfedge_handle(h1))};
 }
 
-VertexInfo::VertexInfo(const TriMesh& mesh) : valence(mesh.n_vertices()), boundary(mesh.n_vertices()) {
-  for (auto v : mesh.vertices()) {
-    valence[v.idx()] = static_cast<int>(mesh.valence(v));
-    boundary[v.idx()] = mesh.is_boundary(v);
-  }
+VertexInfo::VertexInfo(const TriMesh& mesh, unsigned threads)
+    : valence(mesh.n_vertices()), boundary(mesh.n_vertices()) {
+  parallel_for(mesh.n_vertices(), threads, [&](std::size_t i) {
+    const auto v = mesh.vertex_handle(static_cast<unsigned>(i));
+    if (mesh.status(v).deleted()) return;
+    valence[i] = static_cast<int>(mesh.valence(v));
+    boundary[i] = mesh.is_boundary(v);
+  });
 }
 
 bool flip_is_safe(const TriMesh& mesh, EdgeHandle e, double f) {
@@ -113,9 +117,9 @@ std::size_t valence_flip_sweep(TriMesh& mesh, double f) {
   return sweep(mesh, f, info, nullptr);
 }
 
-std::size_t valence_flips(TriMesh& mesh, double f, int max_sweeps) {
+std::size_t valence_flips(TriMesh& mesh, double f, int max_sweeps, unsigned threads) {
   std::size_t total = 0;
-  VertexInfo info(mesh);
+  VertexInfo info(mesh, threads);
   SweepMarks marks(mesh.n_vertices());
   for (int s = 0; s < max_sweeps; ++s) {
     const std::size_t n = sweep(mesh, f, info, &marks);

@@ -33,7 +33,8 @@ struct VertexInfo {
   std::vector<int> valence;
   std::vector<char> boundary;
 
-  explicit VertexInfo(const TriMesh& mesh);
+  /// Circulates every vertex once, on up to `threads` threads.
+  explicit VertexInfo(const TriMesh& mesh, unsigned threads = 1);
   int deviation(OpenMesh::VertexHandle v, int delta) const {
     return std::abs(valence[v.idx()] + delta - (boundary[v.idx()] ? 4 : 6));
   }
@@ -113,8 +114,9 @@ bool flip_improves(const TriMesh& mesh, OpenMesh::EdgeHandle e, double f);
 std::size_t valence_flip_sweep(TriMesh& mesh, double f);
 
 /// Sweeps while they still flip something, at most `max_sweeps` times (the thesis does one; more
-/// sweeps raise regularity at little cost). Returns the total number of flips.
-std::size_t valence_flips(TriMesh& mesh, double f, int max_sweeps = 3);
+/// sweeps raise regularity at little cost). Returns the total number of flips. `threads` count the
+/// valences; the sweeps are serial.
+std::size_t valence_flips(TriMesh& mesh, double f, int max_sweeps = 3, unsigned threads = 1);
 
 /// Safety part of a flip alone (legal, no fold, no degenerate triangle, minimum angle no lower than
 /// f * before). Used by the interval cleanup too.
