@@ -40,23 +40,17 @@ struct Csr {
 struct ReferenceSurface::Impl {
   std::vector<Vec3> points;
   std::vector<std::array<std::uint32_t, 3>> triangles;
-  /// What the candidates' loop tests of a triangle, in one cache line: it reads this for about 65
-  /// triangles per query (nefertiti), and its time goes mostly to waiting for these loads. Four
-  /// arrays before; one line instead of four: 1-7 % less time per run (Table 4.2 setup, 1 thread:
-  /// cheese 7 %, armadillo 1 %), the same output meshes.
-  struct alignas(64) Bound {
-    Vec3 centre;              ///< centroid
-    double radius = 0;        ///< largest distance centroid -> corner
-    Vec3 unit_normal;
-    std::uint32_t folded = 0;  ///< folded back onto a larger neighbour (see kFoldCos); never a candidate
-  };
-  std::vector<Bound> bounds;        ///< per triangle
+  std::vector<Vec3> unit_normals;   ///< per triangle
+  std::vector<Vec3> centres;        ///< per triangle: centroid
+  std::vector<double> radii;        ///< per triangle: largest distance centroid -> corner
   Csr vertex_triangles;             ///< triangles incident to each vertex
   /// per vertex: its longest incident edge, so every incident triangle lies within this distance
   std::vector<double> vertex_reach;
   /// per triangle: the triangle across its edge (corner k, corner k+1), or kNone (boundary edge)
   std::vector<std::array<std::uint32_t, 3>> across;
   static constexpr std::uint32_t kNone = UINT32_MAX;
+  /// per triangle: folded back onto a larger neighbour (see kFoldCos); never a candidate
+  std::vector<std::uint8_t> folded;
   Csr vertex_boundary;              ///< other end of each boundary edge at a vertex
   std::size_t boundary_edges = 0;
   std::size_t neighbours = 30;
@@ -144,7 +138,9 @@ ReferenceSurface::ReferenceSurface(const TriMesh& mesh, std::size_t neighbours)
   }
   if (m.triangles.empty()) throw MeshError("reference surface has no triangles");
   const std::size_t nv = m.points.size(), nt = m.triangles.size();
-  m.bounds.resize(nt);
+  m.unit_normals.resize(nt);
+  m.centres.resize(nt);
+  m.radii.resize(nt);
   std::vector<double> areas(nt);
   m.vertex_triangles.offsets.assign(nv + 1, 0);
   for (std::size_t t = 0; t < nt; ++t) {
@@ -152,12 +148,11 @@ ReferenceSurface::ReferenceSurface(const TriMesh& mesh, std::size_t neighbours)
     const Vec3 &a = m.points[tri[0]], &b = m.points[tri[1]], &c = m.points[tri[2]];
     Vec3 n = geom::cross_normal(a, b, c);
     const double len = n.norm();
-    Impl::Bound& bound = m.bounds[t];
-    bound.unit_normal = len > 0 ? n / len : Vec3(0, 0, 0);
+    m.unit_normals[t] = len > 0 ? n / len : Vec3(0, 0, 0);
     areas[t] = 0.5 * len;
-    bound.centre = (a + b + c) / 3.0;
-    bound.radius = std::sqrt(std::max({(a - bound.centre).sqrnorm(), (b - bound.centre).sqrnorm(),
-                                       (c - bound.centre).sqrnorm()}));
+    m.centres[t] = (a + b + c) / 3.0;
+    m.radii[t] = std::sqrt(std::max({(a - m.centres[t]).sqrnorm(), (b - m.centres[t]).sqrnorm(),
+                                      (c - m.centres[t]).sqrnorm()}));
     for (auto v : tri) ++m.vertex_triangles.offsets[v + 1];
   }
   m.vertex_reach.assign(nv, 0.0);
@@ -183,12 +178,13 @@ ReferenceSurface::ReferenceSurface(const TriMesh& mesh, std::size_t neighbours)
   // row of smaller triangles along its edge the same way (none among the shared meshes; the rule
   // does not check that the larger triangle covers the smaller one).
   constexpr double kFoldCos = -0.95;
+  m.folded.assign(nt, 0);
   for (std::size_t t = 0; t < nt; ++t)
     for (int k = 0; k < 3; ++k) {
       const std::uint32_t u = m.across[t][k];
-      if (u != Impl::kNone && (m.bounds[t].unit_normal | m.bounds[u].unit_normal) < kFoldCos &&
+      if (u != Impl::kNone && (m.unit_normals[t] | m.unit_normals[u]) < kFoldCos &&
           areas[u] > areas[t])
-        m.bounds[t].folded = 1;
+        m.folded[t] = 1;
     }
   // Boundary edges, listed at both ends.
   m.vertex_boundary.offsets.assign(nv + 1, 0);
@@ -267,19 +263,18 @@ Vec3 ReferenceSurface::Impl::closest_point(const Vec3& p, const Vec3& normal_hin
     }
     for (std::uint32_t j = m.vertex_triangles.offsets[v]; j < m.vertex_triangles.offsets[v + 1]; ++j) {
       const std::uint32_t t = m.vertex_triangles.items[j];
-      const Impl::Bound& tb = m.bounds[t];
-      if (tb.folded) continue;
-      const bool agrees = use_hint && (tb.unit_normal | normal_hint) > 0;
+      if (m.folded[t]) continue;
+      const bool agrees = use_hint && (m.unit_normals[t] | normal_hint) > 0;
       // Skip a triangle whose bounding sphere is farther than the candidate it could beat.
       const double bound = agrees ? std::max(best_d, agree_d) : best_d;
       if (bound < kInf) {
-        const Vec3 from_centre = p - tb.centre;
-        const double reach = tb.radius + bound;
+        const Vec3 from_centre = p - m.centres[t];
+        const double reach = m.radii[t] + bound;
         if (from_centre.sqrnorm() > reach * reach) continue;
         // ... or whose plane is: a sliver's bounding sphere is wide (cheese.off: triangles 3.6 by
         // 0.17 around its holes; this test makes its run 15 % faster). The margin keeps the test
         // conservative against rounding.
-        if (std::abs(tb.unit_normal | from_centre) > bound * (1.0 + 1e-9) + 1e-12) continue;
+        if (std::abs(m.unit_normals[t] | from_centre) > bound * (1.0 + 1e-9) + 1e-12) continue;
       }
       const auto& tri = m.triangles[t];
       const Vec3 c = geom::closest_point_on_triangle(p, m.points[tri[0]], m.points[tri[1]], m.points[tri[2]]);
@@ -322,8 +317,8 @@ void ReferenceSurface::Impl::walk(const Vec3& p, const Vec3& normal_hint, std::u
     double next_d2 = d2 * (1.0 - 1e-9);
     for (int k = 0; k < 3; ++k) {
       const std::uint32_t u = across[t][k];
-      if (u == kNone || bounds[u].folded || (bounds[u].unit_normal | bounds[t].unit_normal) < kWalkCos) continue;
-      if (use_hint && (bounds[u].unit_normal | normal_hint) <= 0) continue;
+      if (u == kNone || folded[u] || (unit_normals[u] | unit_normals[t]) < kWalkCos) continue;
+      if (use_hint && (unit_normals[u] | normal_hint) <= 0) continue;
       const auto& tri = triangles[u];
       const Vec3 q = geom::closest_point_on_triangle(p, points[tri[0]], points[tri[1]], points[tri[2]]);
       const double e2 = (q - p).sqrnorm();
