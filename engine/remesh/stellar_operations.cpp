@@ -16,6 +16,7 @@ using OpenMesh::VertexHandle;
 
 bool component_larger_than(const TriMesh& mesh, VertexHandle v, std::size_t n) {
   std::vector<VertexHandle> seen{v};  // at most n + 1: a linear search is fine
+  if (seen.size() > n) return true;
   for (std::size_t i = 0; i < seen.size(); ++i)
     for (auto w : mesh.vv_range(seen[i])) {
       if (std::find(seen.begin(), seen.end(), w) != seen.end()) continue;

@@ -137,32 +137,39 @@ TEST_CASE("a tetrahedron does not collapse away", "[steps]") {
 }
 
 TEST_CASE("a collapse is refused only in a component of 4 vertices or fewer", "[steps]") {
-  // A sphere and a tetrahedron in one mesh: the search from a vertex stays in its component.
+  // In one mesh: a sphere, a square of two triangles (4 vertices: without the rule, its boundary
+  // edges and its diagonal could collapse) and a square pyramid without its base (5 vertices: its
+  // edges may collapse). The search from a vertex stays in its component.
   TriMesh mesh = test::make_icosphere(2);
-  const TriMesh tetra = tetrahedron();
-  OpenMesh::VertexHandle t[4];
-  for (auto v : tetra.vertices()) t[v.idx()] = mesh.add_vertex(tetra.point(v) + Vec3(5, 0, 0));
-  for (auto f : tetra.faces()) {
-    std::vector<OpenMesh::VertexHandle> corners;
-    for (auto v : tetra.fv_range(f)) corners.push_back(t[v.idx()]);
-    mesh.add_face(corners);
-  }
+  const std::size_t sphere = mesh.n_vertices();
+  auto add = [&](std::initializer_list<Vec3> points, std::initializer_list<std::array<int, 3>> faces) {
+    std::vector<OpenMesh::VertexHandle> v;
+    for (const Vec3& p : points) v.push_back(mesh.add_vertex(p));
+    for (const auto& f : faces) mesh.add_face(v[f[0]], v[f[1]], v[f[2]]);
+    return v;
+  };
+  const auto square = add({Vec3(5, 0, 0), Vec3(6, 0, 0), Vec3(6, 1, 0), Vec3(5, 1, 0)}, {{0, 1, 2}, {0, 2, 3}});
+  const auto pyramid = add({Vec3(10, 0, 0), Vec3(11, 0, 0), Vec3(11, 1, 0), Vec3(10, 1, 0), Vec3(10.5, 0.5, 0.3)},
+                           {{0, 1, 4}, {1, 2, 4}, {2, 3, 4}, {3, 0, 4}});
   const auto on_sphere = mesh.vertex_handle(0);
   CHECK(component_larger_than(mesh, on_sphere, 4));
-  CHECK(component_larger_than(mesh, on_sphere, mesh.n_vertices() - 5));
-  CHECK_FALSE(component_larger_than(mesh, on_sphere, mesh.n_vertices() - 4));  // the sphere's own count
-  CHECK(component_larger_than(mesh, t[0], 3));
-  CHECK_FALSE(component_larger_than(mesh, t[0], 4));
-  std::size_t allowed_on_sphere = 0;
+  CHECK(component_larger_than(mesh, on_sphere, sphere - 1));
+  CHECK_FALSE(component_larger_than(mesh, on_sphere, sphere));
+  CHECK(component_larger_than(mesh, square[0], 0));
+  CHECK(component_larger_than(mesh, square[0], 3));
+  CHECK_FALSE(component_larger_than(mesh, square[0], 4));
+  CHECK(component_larger_than(mesh, pyramid[4], 4));
+  CHECK_FALSE(component_larger_than(mesh, pyramid[4], 5));
+  std::size_t allowed[3] = {0, 0, 0};  // sphere, square, pyramid
   for (auto e : mesh.edges()) {
     CollapsePlan plan;
-    const bool ok = plan_collapse(mesh, e, 10.0, 1e9, plan);
-    if (mesh.from_vertex_handle(mesh.halfedge_handle(e, 0)).idx() >= static_cast<int>(mesh.n_vertices()) - 4)
-      CHECK_FALSE(ok);
-    else
-      allowed_on_sphere += ok;
+    const int v = mesh.from_vertex_handle(mesh.halfedge_handle(e, 0)).idx();
+    const int part = v < static_cast<int>(sphere) ? 0 : v < square[3].idx() + 1 ? 1 : 2;
+    allowed[part] += plan_collapse(mesh, e, 10.0, 1e9, plan);
   }
-  CHECK(allowed_on_sphere > 0);
+  CHECK(allowed[0] > 0);
+  CHECK(allowed[1] == 0);
+  CHECK(allowed[2] > 0);
 }
 
 TEST_CASE("eq. 3.1 places the vertex at the minimiser", "[steps]") {
