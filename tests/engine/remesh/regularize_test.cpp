@@ -5,6 +5,7 @@
 #include <array>
 #include <cstdlib>
 #include <random>
+#include <utility>
 #include <vector>
 
 #include "remesh/regularize.h"
@@ -22,14 +23,20 @@ long total_deviation(const TriMesh& m) {
   return d;
 }
 
-/// A mesh with defects: legal flips at random edges, then Algorithm 4's flips until none is left.
-TriMesh scrambled(TriMesh mesh, unsigned seed, int flips) {
+/// Legal flips at random edges: many valence defects.
+TriMesh randomly_flipped(TriMesh mesh, unsigned seed, int flips) {
   std::mt19937 rng(seed);
   std::uniform_int_distribution<unsigned> pick(0, static_cast<unsigned>(mesh.n_edges() - 1));
   for (int i = 0; i < flips; ++i) {
     const auto e = mesh.edge_handle(pick(rng));
     if (flip_is_safe(mesh, e, 0.3)) mesh.flip(e);
   }
+  return mesh;
+}
+
+/// A mesh with defects: randomly_flipped, then Algorithm 4's flips until none is left.
+TriMesh scrambled(TriMesh mesh, unsigned seed, int flips) {
+  mesh = randomly_flipped(std::move(mesh), seed, flips);
   while (valence_flips(mesh, 0.5, 10) > 0) {
   }
   return mesh;
@@ -93,13 +100,8 @@ TEST_CASE("sweeps that visit only the edges around touched vertices flip exactly
   // see edges offered during the sweep itself).
   std::size_t later_flips = 0;
   for (unsigned seed = 1; seed <= 6; ++seed) {
-    TriMesh input = seed % 2 ? test::make_torus(36, 18, 3.0, 1.0) : test::make_icosphere(4);
-    std::mt19937 rng(seed);
-    std::uniform_int_distribution<unsigned> pick(0, static_cast<unsigned>(input.n_edges() - 1));
-    for (int i = 0; i < 700; ++i) {
-      const auto e = input.edge_handle(pick(rng));
-      if (flip_is_safe(input, e, 0.3)) input.flip(e);
-    }
+    const TriMesh input =
+        randomly_flipped(seed % 2 ? test::make_torus(36, 18, 3.0, 1.0) : test::make_icosphere(4), seed, 700);
     for (int sweeps = 1; sweeps <= 4; ++sweeps) {
       TriMesh marked = input, full = input;
       const std::size_t n_marked = valence_flips(marked, 0.5, sweeps);
