@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <array>
 #include <cstdlib>
+#include <initializer_list>
 #include <random>
 #include <utility>
 #include <vector>
@@ -93,29 +94,56 @@ std::vector<std::array<int, 3>> triangles_of(const TriMesh& m) {
 
 }  // namespace
 
+namespace {
+
+/// Flips counted by a sweep procedure: Algorithm 4's alone, or single and paired look-ahead flips.
+struct FlipCount {
+  std::size_t single = 0, pairs = 0;
+};
+
+/// Runs `walked` and `full` (each flips its own copy of the input with the given sweep count) on
+/// every input and sweep count: they must flip as many edges and leave the same triangles. Returns
+/// what `walked` flipped, summed.
+template <class Walked, class Full>
+FlipCount check_same_flips(const std::vector<TriMesh>& inputs, std::initializer_list<int> sweep_counts,
+                           Walked walked, Full full) {
+  FlipCount total;
+  for (const TriMesh& input : inputs)
+    for (int sweeps : sweep_counts) {
+      TriMesh a = input, b = input;
+      const FlipCount na = walked(a, sweeps), nb = full(b, sweeps);
+      CHECK(na.single == nb.single);
+      CHECK(na.pairs == nb.pairs);
+      CHECK(triangles_of(a) == triangles_of(b));
+      total.single += na.single, total.pairs += na.pairs;
+    }
+  return total;
+}
+
+}  // namespace
+
 TEST_CASE("sweeps that visit only the edges around touched vertices flip exactly what full sweeps flip",
           "[steps]") {
   // valence_flips walks the later sweeps over the edges SweepMarks offers; valence_flip_sweep scans
   // every edge. Random legal flips leave many defects, so the sweeps flip a lot (and the later ones
   // see edges offered during the sweep itself).
+  std::vector<TriMesh> inputs;
+  for (unsigned seed = 1; seed <= 6; ++seed)
+    inputs.push_back(
+        randomly_flipped(seed % 2 ? test::make_torus(36, 18, 3.0, 1.0) : test::make_icosphere(4), seed, 700));
   std::size_t later_flips = 0;
-  for (unsigned seed = 1; seed <= 6; ++seed) {
-    const TriMesh input =
-        randomly_flipped(seed % 2 ? test::make_torus(36, 18, 3.0, 1.0) : test::make_icosphere(4), seed, 700);
-    for (int sweeps = 1; sweeps <= 4; ++sweeps) {
-      TriMesh marked = input, full = input;
-      const std::size_t n_marked = valence_flips(marked, 0.5, sweeps);
-      std::size_t n_full = 0;
-      for (int s = 0; s < sweeps; ++s) {
-        const std::size_t n = valence_flip_sweep(full, 0.5);
-        n_full += n;
-        if (s > 0) later_flips += n;
-        if (n == 0) break;
-      }
-      CHECK(n_marked == n_full);
-      CHECK(triangles_of(marked) == triangles_of(full));
-    }
-  }
+  check_same_flips(
+      inputs, {1, 2, 3, 4}, [](TriMesh& m, int sweeps) { return FlipCount{valence_flips(m, 0.5, sweeps)}; },
+      [&](TriMesh& m, int sweeps) {
+        FlipCount n;
+        for (int s = 0; s < sweeps; ++s) {
+          const std::size_t flipped = valence_flip_sweep(m, 0.5);
+          n.single += flipped;
+          if (s > 0) later_flips += flipped;
+          if (flipped == 0) break;
+        }
+        return n;
+      });
   CHECK(later_flips > 0);
 }
 
@@ -170,21 +198,15 @@ RegularizeCounts reference_regularize(TriMesh& mesh, double f, int max_sweeps) {
 
 TEST_CASE("look-ahead flips over the edges around touched vertices make exactly the flips of full sweeps",
           "[steps]") {
-  std::size_t pairs = 0;
-  for (unsigned seed = 1; seed <= 6; ++seed) {
-    const TriMesh input = scrambled(seed % 3 == 0   ? test::make_double_torus(1.0, 3)
-                                    : seed % 3 == 1 ? test::make_torus(36, 18, 3.0, 1.0)
-                                                    : test::make_open_grid(24, 24, 1.0),
-                                    seed, 700);
-    for (int sweeps : {1, 2, 20}) {
-      TriMesh walked = input, full = input;
-      const RegularizeCounts a = regularize(walked, 0.5, sweeps);
-      const RegularizeCounts b = reference_regularize(full, 0.5, sweeps);
-      CHECK(a.single == b.single);
-      CHECK(a.pairs == b.pairs);
-      CHECK(triangles_of(walked) == triangles_of(full));
-      pairs += a.pairs;
-    }
-  }
-  CHECK(pairs > 0);
+  std::vector<TriMesh> inputs;
+  for (unsigned seed = 1; seed <= 6; ++seed)
+    inputs.push_back(scrambled(seed % 3 == 0   ? test::make_double_torus(1.0, 3)
+                               : seed % 3 == 1 ? test::make_torus(36, 18, 3.0, 1.0)
+                                               : test::make_open_grid(24, 24, 1.0),
+                               seed, 700));
+  auto counted = [](RegularizeCounts c) { return FlipCount{c.single, c.pairs}; };
+  const FlipCount walked = check_same_flips(
+      inputs, {1, 2, 20}, [&](TriMesh& m, int sweeps) { return counted(regularize(m, 0.5, sweeps)); },
+      [&](TriMesh& m, int sweeps) { return counted(reference_regularize(m, 0.5, sweeps)); });
+  CHECK(walked.pairs > 0);
 }
