@@ -2,8 +2,10 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <vector>
 
 #include "core/parallel.h"
+#include "remesh/fold_guard.h"
 #include "remesh/interval_cleanup.h"
 #include "remesh/reference_surface.h"
 
@@ -25,19 +27,41 @@ constexpr int kSnapPasses = 3;
 /// 0.67 for about 0.05 s more on bunny.
 constexpr std::size_t kSnapBudgetPer = 50, kSnapBudgetMin = 16;
 
-}  // namespace
-
-FeatureSnap::FeatureSnap(const TriMesh& reference) {
+std::vector<Vec3> interior_points(const TriMesh& reference) {
+  std::vector<Vec3> points;
   for (auto v : reference.vertices())
     if (!reference.status(v).deleted() && !reference.is_isolated(v) && !reference.is_boundary(v))
-      points_.push_back(reference.point(v));
+      points.push_back(reference.point(v));
+  return points;
 }
+
+/// A point's distance to the mesh comes from the triangles around its 30 nearest mesh vertices
+/// (ReferenceSurface::closest_point) and those within that distance. At the interval's spacing the
+/// 30 nearest lie within about 2.4 e_max of the point's foot, so a vertex farther than the gap, the
+/// longest edge at a moved vertex and kUnchangedMargin e_max has no part in it: the points farther
+/// than that from every vertex a pass moved keep their distance, and the next pass does not measure
+/// them again. Measured (Table 4.2 setup, 2 threads): the same output meshes, bit for bit, on the 16
+/// runs compared; with GapJudge's kd-tree (point_index.h) instead of its scan over every point, the
+/// snap takes 0.58 s instead of 0.71 on armadillo and 0.56 instead of 0.70 on nefertiti.
+constexpr double kUnchangedMargin = 3.0;
+
+}  // namespace
+
+/// The points' distances to the mesh from one pass to the next, and what the last pass moved.
+struct FeatureSnap::Gaps {
+  std::vector<double> gap;  ///< per point; empty until the first pass measured them
+  std::vector<Vec3> moved;  ///< positions before and after of the vertices the last pass moved
+  double reach = 0;         ///< beyond this plus its gap from every moved position, a point's gap stands
+};
+
+FeatureSnap::FeatureSnap(const TriMesh& reference) : points_(interior_points(reference)) {}
 
 std::size_t FeatureSnap::apply(TriMesh& mesh, const ReferenceSurface& reference, double e_min, double e_max,
                                unsigned threads) const {
   std::size_t budget = std::max(kSnapBudgetMin, mesh.n_vertices() / kSnapBudgetPer), moved = 0;
+  Gaps gaps;
   for (int i = 0; i < kSnapPasses; ++i) {
-    const std::size_t n = pass(mesh, reference, e_min, e_max, threads, budget);
+    const std::size_t n = pass(mesh, reference, e_min, e_max, threads, budget, gaps);
     moved += n;
     if (n == 0) break;
   }
@@ -46,18 +70,33 @@ std::size_t FeatureSnap::apply(TriMesh& mesh, const ReferenceSurface& reference,
 
 std::size_t FeatureSnap::pass(TriMesh& mesh, const ReferenceSurface& reference, double e_min, double e_max,
                               unsigned threads, std::size_t& budget) const {
-  if (points_.empty() || mesh.n_faces() == 0 || budget == 0) return 0;
+  Gaps gaps;
+  return pass(mesh, reference, e_min, e_max, threads, budget, gaps);
+}
+
+std::size_t FeatureSnap::pass(TriMesh& mesh, const ReferenceSurface& reference, double e_min, double e_max,
+                              unsigned threads, std::size_t& budget, Gaps& gaps) const {
+  const std::vector<Vec3>& points = points_.points();
+  if (points.empty() || mesh.n_faces() == 0 || budget == 0) return 0;
   const ReferenceSurface current(mesh);
   const double tolerance = 0.1 * e_min;
-  std::vector<double> gap(points_.size());
-  parallel_for(points_.size(), threads, [&](std::size_t i) {
-    gap[i] = (current.closest_point(points_[i]) - points_[i]).norm();
-  }, 256);
+  std::vector<double>& gap = gaps.gap;
+  auto measure = [&](std::size_t i) { gap[i] = (current.closest_point(points[i]) - points[i]).norm(); };
+  if (gap.empty()) {
+    gap.resize(points.size());
+    parallel_for(points.size(), threads, measure, 256);
+  } else if (!gaps.moved.empty()) {
+    const PointIndex moved(std::move(gaps.moved));
+    parallel_for(points.size(), threads, [&](std::size_t i) {
+      if (moved.nearest_distance(points[i]) <= gap[i] + gaps.reach) measure(i);
+    }, 256);
+  }
+  gaps.moved.clear();
   // Only the points that decide the Hausdorff distance (kFarShare).
   const double farthest = *std::max_element(gap.begin(), gap.end());
   const double far = std::max(tolerance, kFarShare * farthest);
   std::vector<std::uint32_t> order;
-  for (std::size_t i = 0; i < points_.size(); ++i)
+  for (std::size_t i = 0; i < points.size(); ++i)
     if (gap[i] > far) order.push_back(static_cast<std::uint32_t>(i));
   std::stable_sort(order.begin(), order.end(), [&](auto a, auto b) { return gap[a] > gap[b]; });
   // Each far point takes its nearest mesh vertex that no farther point took already.
@@ -65,15 +104,29 @@ std::size_t FeatureSnap::pass(TriMesh& mesh, const ReferenceSurface& reference, 
   std::vector<SnapMove> moves;
   for (std::uint32_t i : order) {
     std::uint32_t near[3];
-    const std::size_t found = current.nearest_vertices(points_[i], 3, near);
+    const std::size_t found = current.nearest_vertices(points[i], 3, near);
     for (std::size_t k = 0; k < found; ++k) {
       if (taken[near[k]]) continue;
       taken[near[k]] = 1;
-      moves.push_back({mesh.vertex_handle(near[k]), points_[i], gap[i] >= kPartialShare * farthest});
+      moves.push_back({mesh.vertex_handle(near[k]), points[i], gap[i] >= kPartialShare * farthest});
       break;
     }
   }
-  return snap_to_features(mesh, reference, e_min, e_max, moves, points_, budget);
+  const std::vector<Vec3> before = snapshot_points(mesh);
+  const std::size_t kept = snap_to_features(mesh, reference, e_min, e_max, moves, points_, budget);
+  // What moved, for the next pass (a refused move puts its patch back exactly).
+  double longest = 0;
+  for (auto v : mesh.vertices()) {
+    const Vec3& now = mesh.point(v);
+    const Vec3& was = before[v.idx()];
+    if (now == was) continue;
+    gaps.moved.push_back(was);
+    gaps.moved.push_back(now);
+    for (auto w : mesh.vv_range(v))
+      longest = std::max({longest, (mesh.point(w) - now).norm(), (before[w.idx()] - was).norm()});
+  }
+  gaps.reach = longest + kUnchangedMargin * e_max;
+  return kept;
 }
 
 }  // namespace remesh

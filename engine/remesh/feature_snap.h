@@ -19,6 +19,7 @@
 /// vertex whose edges are at 1.77-1.78, takes 15 %). The moved vertex lies on the reference; the relaxed ones
 /// are projected onto it. The passes share a budget of patch relaxations, one per kSnapBudgetPer
 /// vertices of the mesh (at least kSnapBudgetMin): about the cost of one iteration's projection.
+/// A pass after the first measures again only the points near a vertex the last pass moved.
 /// Measured (Table 4.2 setup, Hausdorff in % of the bbox diagonal, exact distances; before ->
 /// after, CGAL's in brackets): spot 0.65 -> 0.44 (0.63), bunny 0.77 -> 0.67 (0.69),
 /// kitten 0.39 -> 0.33 (0.40), fandisk 0.645 -> 0.52 (0.65).
@@ -27,6 +28,7 @@
 #include <vector>
 
 #include "core/mesh.h"
+#include "remesh/point_index.h"
 #include "remesh/reference_surface.h"
 
 namespace remesh {
@@ -49,7 +51,11 @@ class FeatureSnap {
   std::size_t size() const { return points_.size(); }
 
  private:
-  std::vector<Vec3> points_;
+  struct Gaps;
+  std::size_t pass(TriMesh& mesh, const ReferenceSurface& reference, double e_min, double e_max, unsigned threads,
+                   std::size_t& budget, Gaps& gaps) const;
+
+  PointIndex points_;
 };
 
 }  // namespace remesh

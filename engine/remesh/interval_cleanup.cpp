@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <vector>
 
@@ -32,11 +33,16 @@ class GapJudge {
  public:
   /// `reach`: a distance from the target beyond which no point is within e_min of the faces.
   GapJudge(const TriMesh& mesh, std::vector<OpenMesh::FaceHandle> faces, const Vec3& target,
-           const std::vector<Vec3>& points, double e_min, double reach)
+           const PointIndex& points, double e_min, double reach)
       : faces_(std::move(faces)), target_(target) {
     target_before_ = nearest_distance(mesh, target);
-    for (const Vec3& q : points)
+    // The index's test, in its own arithmetic, could differ in the last bit: ask a little wider.
+    std::vector<std::uint32_t> near;
+    points.within(target, reach * (1 + 1e-9), near);
+    for (std::uint32_t i : near) {
+      const Vec3& q = points.points()[i];
       if (q != target && (q - target).sqrnorm() < reach * reach) consider(mesh, q, e_min);
+    }
   }
 
   /// Is the target nearer to the (moved) faces, and every other judged point within its bound?
@@ -436,7 +442,7 @@ class Cleanup {
 
  public:
   /// See snap_to_features() in interval_cleanup.h.
-  bool snap(const SnapMove& move, const std::vector<Vec3>& features, std::size_t& budget) {
+  bool snap(const SnapMove& move, const PointIndex& features, std::size_t& budget) {
     const VertexHandle v = move.v;
     if (mesh_.is_boundary(v) || budget == 0) return false;
     // The patch's faces lie within kPatchRings + 1 edges of v.
@@ -485,7 +491,7 @@ class Cleanup {
 }  // namespace
 
 std::size_t snap_to_features(TriMesh& mesh, const ReferenceSurface& reference, double e_min, double e_max,
-                             const std::vector<SnapMove>& moves, const std::vector<Vec3>& features,
+                             const std::vector<SnapMove>& moves, const PointIndex& features,
                              std::size_t& budget) {
   Cleanup cleanup(mesh, reference, e_min, e_max, 0.5);
   std::size_t moved = 0;

@@ -23,6 +23,7 @@
 #include <vector>
 
 #include "core/mesh.h"
+#include "remesh/point_index.h"
 #include "remesh/reference_surface.h"
 
 namespace remesh {
@@ -70,7 +71,7 @@ struct SnapMove {
 /// target's distance before. Each try (a patch relaxation) takes one from `budget`; none is made
 /// when it is 0. Returns the number of moves kept.
 std::size_t snap_to_features(TriMesh& mesh, const ReferenceSurface& reference, double e_min, double e_max,
-                             const std::vector<SnapMove>& moves, const std::vector<Vec3>& features,
+                             const std::vector<SnapMove>& moves, const PointIndex& features,
                              std::size_t& budget);
 
 }  // namespace remesh

@@ -9,26 +9,13 @@
 #include <utility>
 #include <vector>
 
-#include <nanoflann.hpp>
-
 #include "core/errors.h"
 #include "remesh/geometry.h"
+#include "remesh/kd_tree.h"
 
 namespace remesh {
 
 namespace {
-
-/// nanoflann's view of the reference vertices.
-struct PointCloud {
-  const std::vector<Vec3>* points = nullptr;
-  std::size_t kdtree_get_point_count() const { return points->size(); }
-  double kdtree_get_pt(std::uint32_t i, std::size_t dim) const { return (*points)[i][dim]; }
-  template <class Box>
-  bool kdtree_get_bbox(Box&) const { return false; }
-};
-
-using KdTree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<double, PointCloud>,
-                                                   PointCloud, 3, std::uint32_t>;
 
 /// Compressed lists: items of key i are items[offsets[i] .. offsets[i+1]).
 struct Csr {
@@ -208,7 +195,7 @@ ReferenceSurface::ReferenceSurface(const TriMesh& mesh, std::size_t neighbours)
     }
   }
   m.cloud.points = &m.points;
-  m.tree = std::make_unique<KdTree>(3, m.cloud, nanoflann::KDTreeSingleIndexAdaptorParams(16));
+  m.tree = std::make_unique<KdTree>(3, m.cloud, nanoflann::KDTreeSingleIndexAdaptorParams(kKdTreeLeafSize));
   m.tree->buildIndex();
   static std::atomic<std::uint64_t> next_id{1};
   m.id = next_id++;
