@@ -35,8 +35,7 @@ std::size_t undo_folds(TriMesh& mesh, const std::vector<Vec3>& before, unsigned 
     if (a0 == a1 && b0 == b1 && c0 == c1) return false;
     const Vec3 n0 = n_before(f), n1 = n_now(f);
     if (!geom::normals_agree(n0, n1, 0.0)) return true;
-    const double floor_angle = std::min(geom::kMinAngle, geom::min_angle(a0, b0, c0));
-    if (geom::min_angle(a1, b1, c1) < floor_angle) return true;
+    if (geom::AngleFloor([&] { return geom::min_angle(a0, b0, c0); }).breaks(a1, b1, c1)) return true;
     for (auto h : mesh.fh_range(f)) {
       const auto g = mesh.opposite_face_handle(h);
       if (!g.is_valid()) continue;

@@ -23,6 +23,18 @@ double min_angle(const Vec3& a, const Vec3& b, const Vec3& c) {
   return angle;
 }
 
+bool below_min_angle(const Vec3& a, const Vec3& b, const Vec3& c) {
+  // The smallest angle lies opposite the shortest side, between the two longer ones, and is at
+  // most 60 degrees, where the sine grows with the angle: area2 / (|x| |y|) is its sine. Well
+  // above sin(kMinAngle) (a relative margin far beyond rounding) the angle is above kMinAngle;
+  // else min_angle() decides, so that the answer is always min_angle()'s.
+  static const double sin_min = std::sin(kMinAngle) * (1 + 1e-6);
+  const double la = (b - c).sqrnorm(), lb = (c - a).sqrnorm(), lc = (a - b).sqrnorm();
+  const double longer = la <= lb && la <= lc ? lb * lc : (lb <= lc ? la * lc : la * lb);
+  if (longer > 0 && cross_normal(a, b, c).norm() > sin_min * std::sqrt(longer)) return false;
+  return min_angle(a, b, c) < kMinAngle;
+}
+
 Vec3 closest_point_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
   const Vec3 ab = b - a, ac = c - a, ap = p - a;
   const double d1 = ab | ap, d2 = ac | ap;
@@ -63,6 +75,7 @@ bool normals_agree(const Vec3& before, const Vec3& after, double min_cos) {
 bool adjacent_ok(const Vec3& f_before, const Vec3& g_before, const Vec3& f_after, const Vec3& g_after) {
   const double na = f_after.norm() * g_after.norm();
   if (!(na > 0)) return false;
+  if ((f_after | g_after) >= 0) return true;  // cos_after >= 0 > kMinAdjacentCos
   const double cos_after = (f_after | g_after) / na;
   if (cos_after >= kMinAdjacentCos) return true;
   const double nb = f_before.norm() * g_before.norm();
@@ -148,7 +161,7 @@ double angle_deficit(const TriMesh& mesh, OpenMesh::VertexHandle v) {
 }
 
 bool move_is_safe(const TriMesh& mesh, OpenMesh::VertexHandle v, const Vec3& p) {
-  const double floor_angle = std::min(kMinAngle, star_min_angle(mesh, v));
+  AngleFloor floor([&] { return star_min_angle(mesh, v); });
   // No fold between a face of the star and any of its neighbours.
   for (auto h : mesh.voh_range(v)) {
     const auto f = mesh.face_handle(h);
@@ -168,7 +181,7 @@ bool move_is_safe(const TriMesh& mesh, OpenMesh::VertexHandle v, const Vec3& p) 
     const Vec3 before = face_normal(mesh, f);
     const Vec3 after = cross_normal(q[0], q[1], q[2]);
     if (!normals_agree(before, after)) return false;
-    if (min_angle(q[0], q[1], q[2]) < floor_angle) return false;
+    if (floor.breaks(q[0], q[1], q[2])) return false;
   }
   return true;
 }

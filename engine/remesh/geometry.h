@@ -3,6 +3,7 @@
 /// Small geometric helpers shared by the steps: angles, closest point on a triangle, normals and the
 /// fold / degeneracy tests every mesh edit must pass.
 
+#include <utility>
 #include <vector>
 
 #include "core/mesh.h"
@@ -25,6 +26,31 @@ Vec3 closest_point_on_segment(const Vec3& p, const Vec3& a, const Vec3& b);
 /// degenerate; an edit may still create one no worse than the worst it replaces.
 constexpr double kMinAngle = 1.0 * 3.14159265358979323846 / 180.0;
 
+/// min_angle(a, b, c) < kMinAngle, the same answer without the arc tangent for a triangle whose
+/// smallest angle is clearly larger (nearly every call of the fold tests).
+bool below_min_angle(const Vec3& a, const Vec3& b, const Vec3& c);
+
+/// The degeneracy rule of every edit: a triangle it makes may have its smallest angle below
+/// kMinAngle only if no worse than the worst triangle it replaces, whose angle `worst()` returns.
+/// worst() runs at most once, and only for a new triangle below kMinAngle: the arc tangents of the
+/// old triangles are nearly never needed.
+template <class Worst>
+class AngleFloor {
+ public:
+  explicit AngleFloor(Worst worst) : worst_(std::move(worst)) {}
+  /// Would triangle (a, b, c) break the rule? Equal to min_angle(a, b, c) < min(kMinAngle, worst()).
+  bool breaks(const Vec3& a, const Vec3& b, const Vec3& c) {
+    if (!below_min_angle(a, b, c)) return false;
+    if (!known_) worst_angle_ = worst_(), known_ = true;
+    return min_angle(a, b, c) < worst_angle_;
+  }
+
+ private:
+  Worst worst_;
+  bool known_ = false;
+  double worst_angle_ = 0;
+};
+
 /// Smallest cosine between the normal of a triangle before and after an edit (about 60 degrees).
 /// Below it the edit folds or badly tilts the triangle and is refused.
 constexpr double kMinNormalCos = 0.5;
@@ -33,6 +59,7 @@ constexpr double kMinNormalCos = 0.5;
 /// angle of 60 degrees between them); an edit may keep a pair that was already sharper, not
 /// sharpen it further.
 constexpr double kMinAdjacentCos = -0.5;
+static_assert(kMinAdjacentCos <= 0, "adjacent_ok() accepts a pair with a non-negative cosine at once");
 
 /// Is the pair of adjacent faces (unnormalised normals, before and after an edit) acceptable?
 bool adjacent_ok(const Vec3& f_before, const Vec3& g_before, const Vec3& f_after, const Vec3& g_after);

@@ -267,10 +267,10 @@ class Cleanup {
       const Vec3& y = mesh_.point(mesh_.to_vertex_handle(g));
       const Vec3& z = mesh_.point(mesh_.to_vertex_handle(mesh_.next_halfedge_handle(g)));
       const Vec3 before = geom::cross_normal(x, y, z);
-      const double floor_angle = std::min(geom::kMinAngle, geom::min_angle(x, y, z));
+      geom::AngleFloor floor([&] { return geom::min_angle(x, y, z); });
       for (const auto& [u, w] : {std::pair<Vec3, Vec3>{x, p}, std::pair<Vec3, Vec3>{p, y}}) {
         if (!geom::normals_agree(before, geom::cross_normal(u, w, z))) return false;
-        if (geom::min_angle(u, w, z) < floor_angle) return false;
+        if (floor.breaks(u, w, z)) return false;
       }
     }
     return true;

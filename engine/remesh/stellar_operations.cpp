@@ -37,8 +37,8 @@ bool split_point_ok(const TriMesh& mesh, EdgeHandle e, const Vec3& p) {
     const Vec3& a = mesh.point(mesh.from_vertex_handle(h));
     const Vec3& b = mesh.point(mesh.to_vertex_handle(h));
     const Vec3& c = mesh.point(mesh.to_vertex_handle(mesh.next_halfedge_handle(h)));
-    const double floor_angle = std::min(geom::kMinAngle, geom::min_angle(a, b, c));
-    if (geom::min_angle(a, p, c) < floor_angle || geom::min_angle(p, b, c) < floor_angle) return false;
+    geom::AngleFloor floor([&] { return geom::min_angle(a, b, c); });
+    if (floor.breaks(a, p, c) || floor.breaks(p, b, c)) return false;
   }
   return true;
 }
@@ -69,7 +69,7 @@ VertexHandle split_edge(TriMesh& mesh, EdgeHandle e, double target) {
 bool collapse_geometry_ok(const TriMesh& mesh, HalfedgeHandle h, const Vec3& p, double max_length) {
   const VertexHandle v0 = mesh.from_vertex_handle(h), v1 = mesh.to_vertex_handle(h);
   const FaceHandle gone0 = mesh.face_handle(h), gone1 = mesh.face_handle(mesh.opposite_halfedge_handle(h));
-  const double floor_angle = std::min({geom::kMinAngle, geom::star_min_angle(mesh, v0), geom::star_min_angle(mesh, v1)});
+  geom::AngleFloor floor([&] { return std::min(geom::star_min_angle(mesh, v0), geom::star_min_angle(mesh, v1)); });
   for (VertexHandle end : {v0, v1}) {
     for (auto f : mesh.vf_range(end)) {
       if (f == gone0 || f == gone1) continue;
@@ -79,7 +79,7 @@ bool collapse_geometry_ok(const TriMesh& mesh, HalfedgeHandle h, const Vec3& p, 
       for (int k = 0; k < 3; ++k) q[k] = (c[k] == v0 || c[k] == v1) ? p : mesh.point(c[k]);
       const Vec3 n_after = geom::cross_normal(q[0], q[1], q[2]);
       if (!geom::normals_agree(geom::face_normal(mesh, f), n_after)) return false;
-      if (geom::min_angle(q[0], q[1], q[2]) < floor_angle) return false;
+      if (floor.breaks(q[0], q[1], q[2])) return false;
       // No fold against a neighbour (those across the removed faces are not checked).
       for (auto g : mesh.ff_range(f)) {
         if (g == gone0 || g == gone1) continue;
