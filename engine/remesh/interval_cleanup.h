@@ -31,6 +31,8 @@ namespace remesh {
 struct CleanupCounts {
   std::size_t flips = 0, collapses = 0, splits = 0, relocations = 0, patches = 0;
   std::size_t outside_before = 0, outside_after = 0;  ///< edges outside [e_min, e_max]
+  /// Edges passed over because no fix could mend them last time and nothing near them changed.
+  std::size_t skipped = 0;
 };
 
 /// How one cleanup runs (equalize.cpp: a per-iteration and a final form).
@@ -48,6 +50,9 @@ struct CleanupOptions {
   /// The projection's per-vertex kd-tree answers (projection.h), reused and refreshed by the
   /// cleanup's projections (exact either way); may be null.
   std::vector<NeighbourCache>* caches = nullptr;
+  /// Pass over an edge that no fix could mend, while nothing within 4 rings of it has changed
+  /// since (every fix would fail again). The result is the same either way; off only to check that.
+  bool remember_failures = true;
 };
 
 /// Runs the cleanup. Precondition: no deleted elements (garbage-collected); it leaves the mesh
