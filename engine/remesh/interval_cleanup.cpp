@@ -132,6 +132,7 @@ class Cleanup {
         if (patch_budget_ > 0 && !patch_failed(e)) --patch_budget_, failed_patches_.push_back(e.idx());
         continue;
       }
+      const std::size_t budget_before = patch_budget_;
       if (try_flip(e)) {
         ++counts.flips;
       } else if (!is_long && try_collapse(e)) {
@@ -143,7 +144,10 @@ class Cleanup {
       } else if (patch_budget_ > 0 && !patch_failed(e) && (--patch_budget_, try_relax_patch(e))) {
         ++counts.patches;
       } else {
-        record_failure(e);
+        // A failure counts only with the patch relaxation tried, or out of budget for good: a
+        // patch passed over because it failed in an earlier state of the neighbourhood may
+        // succeed in this one once failed_patches_ is cleared.
+        if (patch_budget_ != budget_before || patch_budget_ == 0) record_failure(e);
         continue;
       }
       ++fixes;

@@ -414,6 +414,8 @@ TEST_CASE("the cleanup's failure memory changes nothing but the work", "[steps]"
   cases.push_back({test::make_torus(80, 16, 8.0, 0.6), test::make_torus(34, 5, 8.0, 0.6)});
   cases.push_back({test::make_icosphere(5, 12.0), test::make_icosphere(3, 12.0)});
   cases.push_back({test::make_torus(90, 30, 9.0, 3.0), test::make_torus(40, 12, 9.0, 3.0)});
+  cases.push_back({test::make_torus(70, 10, 7.0, 0.45), test::make_torus(30, 4, 7.0, 0.45)});
+  cases.push_back({test::make_icosphere(5, 9.0), test::make_icosphere(3, 9.0)});
   std::size_t skipped = 0;
   for (std::size_t c = 0; c < cases.size(); ++c) {
     CAPTURE(c);
@@ -421,11 +423,11 @@ TEST_CASE("the cleanup's failure memory changes nothing but the work", "[steps]"
     for (auto v : start.vertices()) start.point(v) += Vec3(jitter(rng), jitter(rng), jitter(rng));
     const ReferenceSurface reference(cases[c].reference);
     project_onto_reference(start, reference, 2);
-    for (const std::size_t budget : {std::size_t{0}, std::size_t{4}}) {  // 0: the default budget
+    for (const std::size_t budget : {std::size_t{0}, std::size_t{4}, std::size_t{16}}) {  // 0: the default
       CAPTURE(budget);
       TriMesh with = start, without = start;
       CleanupOptions options;
-      options.rounds = 8;
+      options.rounds = 12;
       options.patch_budget = budget;
       const CleanupCounts a = interval_cleanup(with, reference, 1.2, 1.8, 0.5, options);
       options.remember_failures = false;
