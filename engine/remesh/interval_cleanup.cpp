@@ -182,7 +182,7 @@ class Cleanup {
   /// edge is passed over. Measured (Table 4.2 setup, 2 threads): the same output meshes on all 22
   /// runs; cheese's simplification 12.3 -> 10.3 s, cow's 1.15 -> 1.00 s, cheese's refinement
   /// 2.46 -> 2.36 s.
-  static constexpr int kFailureRings = 4;
+  static constexpr std::size_t kFailureRings = 4;
 
   void stamp(VertexHandle v) {
     if (changed_at_.size() <= static_cast<std::size_t>(v.idx())) changed_at_.resize(mesh_.n_vertices(), 0);
@@ -199,36 +199,21 @@ class Cleanup {
     failed_at_[e.idx()] = clock_;
   }
 
-  /// Did e fail before, with nothing within kFailureRings rings of its ends changed since? A
-  /// walk from the ends in the current mesh: were the connectivity there changed, a vertex whose
-  /// faces changed would lie on the walk, stamped.
+  /// Did e fail before, with nothing within kFailureRings rings of its ends changed since? The
+  /// rings are those of the current mesh: were the connectivity there changed, a vertex whose faces
+  /// changed would lie in them, stamped.
   bool unchanged_since_failure(EdgeHandle e) {
     if (static_cast<std::size_t>(e.idx()) >= failed_at_.size() || failed_at_[e.idx()] == 0) return false;
     const std::uint32_t failed = failed_at_[e.idx()];
-    if (seen_.size() < mesh_.n_vertices()) seen_.resize(mesh_.n_vertices(), 0);
-    if (++walk_ == 0) std::fill(seen_.begin(), seen_.end(), 0), walk_ = 1;
-    auto later = [&](VertexHandle v) {
+    const HalfedgeHandle h = mesh_.halfedge_handle(e, 0);
+    auto changed = [&](VertexHandle v) {
       return static_cast<std::size_t>(v.idx()) < changed_at_.size() && changed_at_[v.idx()] > failed;
     };
-    const HalfedgeHandle h = mesh_.halfedge_handle(e, 0);
-    std::vector<VertexHandle>& ring = walk_ring_;
-    ring.assign({mesh_.from_vertex_handle(h), mesh_.to_vertex_handle(h)});
-    for (auto v : ring) {
-      if (later(v)) return false;
-      seen_[v.idx()] = walk_;
-    }
-    for (std::size_t begin = 0, r = 0; r < kFailureRings; ++r) {
-      const std::size_t end = ring.size();
-      for (std::size_t i = begin; i < end; ++i)
-        for (auto w : mesh_.vv_range(ring[i])) {
-          if (seen_[w.idx()] == walk_) continue;
-          if (later(w)) return false;
-          seen_[w.idx()] = walk_;
-          ring.push_back(w);
-        }
-      begin = end;
-    }
-    return true;
+    std::vector<VertexHandle>& near = near_;
+    near.assign({mesh_.from_vertex_handle(h), mesh_.to_vertex_handle(h)});
+    const bool unchanged = !changed(near[0]) && !changed(near[1]) && grow_rings(near, kFailureRings, changed);
+    for (auto v : near) patch_mark_[v.idx()] = 0;
+    return unchanged;
   }
 
   bool try_flip(EdgeHandle e) {
@@ -435,25 +420,32 @@ class Cleanup {
     return std::find(failed_patches_.begin(), failed_patches_.end(), e.idx()) != failed_patches_.end();
   }
 
-  /// Adds to `patch` every vertex within kPatchRings rings of it, marking all in patch_mark_ (the
-  /// caller clears the marks).
-  void grow_patch(std::vector<VertexHandle>& patch) {
+  /// Adds to `patch` every vertex within `rings` rings of it (kPatchRings for a patch), marking
+  /// all in patch_mark_ (the caller clears the marks). Stops early, returning false, at the first
+  /// vertex added for which `stop` is true.
+  template <class Stop = bool (*)(VertexHandle)>
+  bool grow_rings(std::vector<VertexHandle>& patch, std::size_t rings = kPatchRings,
+                  Stop stop = [](VertexHandle) { return false; }) {
     std::vector<char>& in = patch_mark_;
     if (in.size() < mesh_.n_vertices()) in.assign(mesh_.n_vertices(), 0);
     for (auto v : patch) in[v.idx()] = 1;
-    for (std::size_t begin = 0, r = 0; r < kPatchRings; ++r) {
+    for (std::size_t begin = 0, r = 0; r < rings; ++r) {
       const std::size_t end = patch.size();
       for (std::size_t i = begin; i < end; ++i)
         for (auto w : mesh_.vv_range(patch[i]))
-          if (!in[w.idx()]) in[w.idx()] = 1, patch.push_back(w);
+          if (!in[w.idx()]) {
+            in[w.idx()] = 1, patch.push_back(w);
+            if (stop(w)) return false;
+          }
       begin = end;
     }
+    return true;
   }
 
   /// The faces a relaxation of the patch around v can move: those incident to its vertices.
   std::vector<OpenMesh::FaceHandle> patch_faces(VertexHandle v) {
     std::vector<VertexHandle> patch{v};
-    grow_patch(patch);
+    grow_rings(patch);
     std::vector<OpenMesh::FaceHandle> faces;
     for (auto u : patch) {
       patch_mark_[u.idx()] = 0;
@@ -471,7 +463,7 @@ class Cleanup {
   bool relax_patch(std::vector<VertexHandle> patch, VertexHandle pinned, const Vec3& pin_at, bool allow_equal,
                    const GapJudge* judge = nullptr) {
     std::vector<char>& in = patch_mark_;
-    grow_patch(patch);
+    grow_rings(patch);
     // Edges of the patch: those with an end inside it.
     auto measure = [&]() {
       std::size_t n = 0;
@@ -560,7 +552,7 @@ class Cleanup {
   bool collapsed_ = false;              ///< deleted elements to collect (finish)
   bool collapsed_since_round_ = false;  ///< a collapse in the current round
   std::vector<Vec3> ring_;        ///< a vertex's 1-ring points, for relocate and relax_patch (reused buffer)
-  std::vector<char> patch_mark_;  ///< try_relax_patch's membership flags, all zero between calls
+  std::vector<char> patch_mark_;  ///< grow_rings' membership flags, all zero between calls
   std::vector<NeighbourCache> patch_caches_;  ///< relax_patch's kd-tree answers, one per patch vertex
   /// The iterations' kd-tree answers, one per vertex index (projection.h), when the caller keeps
   /// them: a relocated vertex has moved little since its projection, so its answer is mostly
@@ -572,9 +564,7 @@ class Cleanup {
   std::uint32_t clock_ = 0;                   ///< ticks once per fix (failure memory)
   std::vector<std::uint32_t> changed_at_;     ///< per vertex: the tick of the last fix that changed it
   std::vector<std::uint32_t> failed_at_;      ///< per edge: the tick at its last failure, 0 = none
-  std::vector<std::uint32_t> seen_;           ///< unchanged_since_failure's walk marks
-  std::uint32_t walk_ = 0;
-  std::vector<VertexHandle> walk_ring_;
+  std::vector<VertexHandle> near_;            ///< unchanged_since_failure's rings (reused buffer)
   /// Patch relaxations left in this cleanup (interval_cleanup's `patch_budget`).
   std::size_t patch_budget_ = std::max<std::size_t>(64, mesh_.n_edges() / 1000);
 };
