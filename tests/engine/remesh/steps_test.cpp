@@ -403,8 +403,10 @@ TEST_CASE("a mesh snapshot rebuilds the live vertices and faces in their order",
 
 TEST_CASE("the cleanup's failure memory changes nothing but the work", "[steps]") {
   // Meshes with edges no fix can mend (a tube too thin for the interval, a jittered sphere): the
-  // cleanup with the memory (edges passed over while nothing near them changed) and without it
-  // must give the same mesh, vertex for vertex and face for face, and the same counts.
+  // cleanup with the memory (edges and relocations passed over while nothing near them changed)
+  // and without it must give the same mesh, vertex for vertex and face for face, and the same
+  // counts. The last case, a thin tube with short edges, fails when a relocation is remembered
+  // over 1 ring instead of 2.
   std::mt19937 rng(5);
   std::normal_distribution<double> jitter(0.0, 0.25);
   struct Case {
@@ -416,6 +418,7 @@ TEST_CASE("the cleanup's failure memory changes nothing but the work", "[steps]"
   cases.push_back({test::make_torus(90, 30, 9.0, 3.0), test::make_torus(40, 12, 9.0, 3.0)});
   cases.push_back({test::make_torus(70, 10, 7.0, 0.45), test::make_torus(30, 4, 7.0, 0.45)});
   cases.push_back({test::make_icosphere(5, 9.0), test::make_icosphere(3, 9.0)});
+  cases.push_back({test::make_torus(100, 14, 7.0, 0.5), test::make_torus(100, 14, 7.0, 0.5)});
   std::size_t skipped = 0;
   for (std::size_t c = 0; c < cases.size(); ++c) {
     CAPTURE(c);
