@@ -104,24 +104,26 @@ bool plan_collapse(const TriMesh& mesh, EdgeHandle e, double target, double max_
   HalfedgeHandle h = mesh.halfedge_handle(e, 0);
   VertexHandle v0 = mesh.from_vertex_handle(h), v1 = mesh.to_vertex_handle(h);
   if (!component_larger_than(mesh, v0, 4)) return false;
-  const bool b0 = mesh.is_boundary(v0), b1 = mesh.is_boundary(v1);
-  Vec3 p;
-  if (mesh.is_boundary(e)) {
-    // Along the boundary curve: the kept vertex stays on the edge.
+  const bool b0 = mesh.is_boundary(v0), b1 = mesh.is_boundary(v1), along_boundary = mesh.is_boundary(e);
+  if (along_boundary) {
     if (!boundary_loop_longer_than_3(mesh, h)) return false;
-    const Vec3 a = mesh.point(v0), b = mesh.point(v1);
-    p = a + (b - a) * equalizing_parameter(a, b, collapse_neighbours(mesh, h), target);
   } else if (b0 && b1) {
     return false;  // interior edge between two boundary vertices: would pinch
-  } else if (b0 || b1) {
-    if (b0) h = mesh.opposite_halfedge_handle(h), std::swap(v0, v1);  // remove the interior end
-    p = mesh.point(v1);
-  } else {
-    const Vec3 a = mesh.point(v0), b = mesh.point(v1);
-    p = a + (b - a) * equalizing_parameter(a, b, collapse_neighbours(mesh, h), target);
+  } else if (b0) {
+    h = mesh.opposite_halfedge_handle(h), std::swap(v0, v1);  // remove the interior end
   }
+  // The link condition before the position, which it does not depend on: on thin parts it fails
+  // for a third of the cleanup's collapses (cheese's simplification: 191 000 of 508 000).
   // is_collapse_ok is not const in OpenMesh 9 but only reads (it uses status bits it resets).
   if (!const_cast<TriMesh&>(mesh).is_collapse_ok(h)) return false;
+  Vec3 p;
+  if (along_boundary || !(b0 || b1)) {
+    // On the edge at the eq. 3.1 parameter (for a boundary edge, on the boundary curve).
+    const Vec3 a = mesh.point(v0), b = mesh.point(v1);
+    p = a + (b - a) * equalizing_parameter(a, b, collapse_neighbours(mesh, h), target);
+  } else {
+    p = mesh.point(v1);  // the boundary end stays
+  }
   if (!collapse_geometry_ok(mesh, h, p, max_length)) return false;
   plan.halfedge = h;
   plan.position = p;
