@@ -191,43 +191,43 @@ class Cleanup {
   /// cannot be mended): 79 % of 927 000 relocations were such repeats.
   static constexpr std::size_t kRelocateRings = 2;
 
-  void stamp(VertexHandle v) {
-    if (changed_at_.size() <= static_cast<std::size_t>(v.idx())) changed_at_.resize(mesh_.n_vertices(), 0);
-    changed_at_[v.idx()] = clock_;
+  /// A tick per vertex or edge index, 0 = none; the vectors grow with the mesh (splits add elements).
+  static std::uint32_t tick_of(const std::vector<std::uint32_t>& ticks, int idx) {
+    return static_cast<std::size_t>(idx) < ticks.size() ? ticks[idx] : 0;
   }
+  void set_tick(std::vector<std::uint32_t>& ticks, int idx, std::size_t elements) const {
+    if (ticks.size() <= static_cast<std::size_t>(idx)) ticks.resize(elements, 0);
+    ticks[idx] = clock_;
+  }
+
+  void stamp(VertexHandle v) { set_tick(changed_at_, v.idx(), mesh_.n_vertices()); }
   /// Stamps v and its neighbours (a flip, collapse or split changes the faces of each).
   void stamp_star(VertexHandle v) {
     stamp(v);
     for (auto w : mesh_.vv_range(v)) stamp(w);
   }
 
-  void record_failure(EdgeHandle e) {
-    if (failed_at_.size() <= static_cast<std::size_t>(e.idx())) failed_at_.resize(mesh_.n_edges(), 0);
-    failed_at_[e.idx()] = clock_;
-  }
+  void record_failure(EdgeHandle e) { set_tick(failed_at_, e.idx(), mesh_.n_edges()); }
 
   /// Did e fail before, with nothing within kFailureRings rings of its ends changed since? The
   /// rings are those of the current mesh: were the connectivity there changed, a vertex whose faces
   /// changed would lie in them, stamped.
   bool unchanged_since_failure(EdgeHandle e) {
-    if (static_cast<std::size_t>(e.idx()) >= failed_at_.size() || failed_at_[e.idx()] == 0) return false;
+    const std::uint32_t failed = tick_of(failed_at_, e.idx());
+    if (failed == 0) return false;
     const HalfedgeHandle h = mesh_.halfedge_handle(e, 0);
-    return unchanged_since(failed_at_[e.idx()], {mesh_.from_vertex_handle(h), mesh_.to_vertex_handle(h)},
-                           kFailureRings);
+    return unchanged_since(failed, {mesh_.from_vertex_handle(h), mesh_.to_vertex_handle(h)}, kFailureRings);
   }
 
   /// Did relocate(v) fail before, with nothing within kRelocateRings rings of v changed since?
   bool relocation_unchanged(VertexHandle v) {
-    if (static_cast<std::size_t>(v.idx()) >= relocate_failed_at_.size() || relocate_failed_at_[v.idx()] == 0)
-      return false;
-    return unchanged_since(relocate_failed_at_[v.idx()], {v}, kRelocateRings);
+    const std::uint32_t failed = tick_of(relocate_failed_at_, v.idx());
+    return failed != 0 && unchanged_since(failed, {v}, kRelocateRings);
   }
 
   /// Is no vertex within `rings` rings of `seeds` stamped later than `tick`?
   bool unchanged_since(std::uint32_t tick, std::initializer_list<VertexHandle> seeds, std::size_t rings) {
-    auto changed = [&](VertexHandle v) {
-      return static_cast<std::size_t>(v.idx()) < changed_at_.size() && changed_at_[v.idx()] > tick;
-    };
+    auto changed = [&](VertexHandle v) { return tick_of(changed_at_, v.idx()) > tick; };
     if (std::any_of(seeds.begin(), seeds.end(), changed)) return false;
     std::vector<VertexHandle>& near = near_;
     near.assign(seeds);
@@ -404,11 +404,7 @@ class Cleanup {
     const auto [n_after, e_after] = outside_around(v, p);
     if (n_after > n_before || (n_after == n_before && !(e_after < 0.9 * e_before)) ||
         !geom::move_is_safe(mesh_, v, p)) {
-      if (remember_failures_) {
-        if (relocate_failed_at_.size() <= static_cast<std::size_t>(v.idx()))
-          relocate_failed_at_.resize(mesh_.n_vertices(), 0);
-        relocate_failed_at_[v.idx()] = clock_;
-      }
+      if (remember_failures_) set_tick(relocate_failed_at_, v.idx(), mesh_.n_vertices());
       return false;
     }
     mesh_.point(v) = p;

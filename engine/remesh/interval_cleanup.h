@@ -51,7 +51,8 @@ struct CleanupOptions {
   /// cleanup's projections (exact either way); may be null.
   std::vector<NeighbourCache>* caches = nullptr;
   /// Pass over an edge that no fix could mend, while nothing within 4 rings of it has changed
-  /// since (every fix would fail again). The result is the same either way; off only to check that.
+  /// since, and a relocation that failed, while nothing within 2 rings of its vertex has (each
+  /// would fail again). The result is the same either way; off only to check that.
   bool remember_failures = true;
 };
 
