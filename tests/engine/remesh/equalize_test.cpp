@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "remesh/equalize.h"
+#include "remesh/self_intersections.h"
 #include "support/mesh_generators.h"
 #include "test_helpers.h"
 
@@ -35,13 +36,16 @@ Topology topology(const TriMesh& m) {
   return {test::euler_characteristic(m), test::count_boundary_loops(m), test::count_components(m)};
 }
 
-/// Remeshes and checks what must hold for any input: valid, same topology.
+/// Remeshes and checks what must hold for any input: valid, same topology, no faces crossing
+/// (none of the inputs has any).
 IterationStats remesh_and_check(TriMesh& mesh, const Params& p) {
   const Topology before = topology(mesh);
+  REQUIRE(find_self_intersections(mesh, 1).empty());
   IterationStats last;
   equalize(mesh, p, [&](const IterationStats& s) { last = s; });
   CHECK(test::check_mesh_valid(mesh) == "");
   CHECK(topology(mesh) == before);
+  CHECK(find_self_intersections(mesh, 1).empty());
   return last;
 }
 

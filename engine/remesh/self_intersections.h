@@ -1,0 +1,49 @@
+#pragma once
+/// \file self_intersections.h
+/// Not in the thesis: which faces of the mesh cross each other. The fold guard (fold_guard.h) and
+/// the checks of every edit look only at a vertex's own faces and their neighbours; where the
+/// reference itself is crumpled (nefertiti's base: thin triangles folded over their neighbours) or
+/// two sheets of the surface lie closer than an edge, the projection can put faces a few rings
+/// apart through each other. untangle.h moves them apart.
+
+#include <array>
+#include <utility>
+#include <vector>
+
+#include "core/mesh.h"
+
+namespace remesh {
+
+/// Do triangles (a, b, c) and (d, e, f) share a point other than the corners they have in common?
+/// Corners are shared when they are equal points. Two triangles with two corners in common (an edge)
+/// count as not crossing (one would have to fold onto the other, which the edits never do).
+/// Coplanar triangles count as not crossing. Exact up to the rounding of the orientation tests.
+bool triangles_cross(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d, const Vec3& e, const Vec3& f);
+
+/// triangles_cross for faces f and g of `mesh`; faces with an edge in common never cross.
+bool faces_cross(const TriMesh& mesh, OpenMesh::FaceHandle f, OpenMesh::FaceHandle g);
+
+/// Per face index: the centroid and the largest distance from it to a corner (a bounding sphere).
+struct FaceSpheres {
+  std::vector<Vec3> centres;
+  std::vector<double> radii;
+  std::vector<std::array<int, 3>> corners;  ///< vertex indices
+  double largest = 0;  ///< the largest radius
+};
+FaceSpheres face_spheres(const TriMesh& mesh);
+
+/// An axis-aligned box.
+struct Box {
+  Vec3 lo, hi;
+};
+
+/// Does the sphere (centre, radius) meet `box` grown by `grow` on every side?
+bool sphere_meets(const Box& box, const Vec3& centre, double radius, double grow = 0);
+
+/// Every pair (f, g), f < g, of faces of `mesh` that cross (faces_cross), sorted; with `region`,
+/// only the pairs with a face whose bounding sphere meets it. Precondition: no deleted elements.
+/// Parallel; the same answer whatever the thread count.
+std::vector<std::pair<unsigned, unsigned>> find_self_intersections(const TriMesh& mesh, unsigned threads,
+                                                                   const Box* region = nullptr);
+
+}  // namespace remesh

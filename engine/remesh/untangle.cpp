@@ -1,0 +1,436 @@
+#include "remesh/untangle.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <numeric>
+#include <optional>
+#include <unordered_map>
+#include <utility>
+#include <vector>
+
+#include "remesh/geometry.h"
+#include "remesh/point_index.h"
+#include "remesh/projection.h"
+#include "remesh/self_intersections.h"
+
+namespace remesh {
+
+namespace {
+
+using OpenMesh::FaceHandle;
+using OpenMesh::HalfedgeHandle;
+using OpenMesh::VertexHandle;
+using Pairs = std::vector<std::pair<unsigned, unsigned>>;
+
+/// Rounds of vertex moves, each over the vertices of the crossing faces left.
+constexpr int kMoveRounds = 8;
+/// The fractions of the way to the ring's centroid a vertex move tries in turn.
+constexpr double kSteps[] = {1.0, 0.5, 0.25};
+/// The largest disk a tangle is flattened in: its vertices within this many rings of the tangle's.
+constexpr std::size_t kMaxPatchRings = 4;
+/// Gauss-Seidel sweeps of the membrane at most, and the move (relative to the mean edge of the
+/// disk) below which it counts as settled.
+constexpr int kMembraneSweeps = 2000;
+constexpr double kMembraneSettled = 1e-4;
+/// How far (in e_min) a membrane vertex may lie from the reference.
+constexpr double kMaxFlattening = 1.0;
+
+/// Vertices of the faces of `pairs`, each once, in increasing order.
+std::vector<VertexHandle> vertices_of(const TriMesh& mesh, const Pairs& pairs) {
+  std::vector<VertexHandle> out;
+  for (const auto& [f, g] : pairs)
+    for (unsigned face : {f, g})
+      for (auto v : mesh.fv_range(mesh.face_handle(face))) out.push_back(v);
+  std::sort(out.begin(), out.end());
+  out.erase(std::unique(out.begin(), out.end()), out.end());
+  return out;
+}
+
+/// The faces of `pairs` grouped into tangles (connected through shared vertices), each tangle given
+/// by its vertices, in increasing order.
+std::vector<std::vector<VertexHandle>> tangles(const TriMesh& mesh, const Pairs& pairs) {
+  const std::vector<VertexHandle> vertices = vertices_of(mesh, pairs);
+  std::unordered_map<int, std::size_t> slot;
+  for (std::size_t i = 0; i < vertices.size(); ++i) slot[vertices[i].idx()] = i;
+  std::vector<std::size_t> parent(vertices.size());
+  std::iota(parent.begin(), parent.end(), 0);
+  auto root = [&](std::size_t i) {
+    while (parent[i] != i) i = parent[i] = parent[parent[i]];
+    return i;
+  };
+  for (const auto& [f, g] : pairs)
+    for (unsigned face : {f, g}) {
+      std::size_t first = SIZE_MAX;
+      for (auto v : mesh.fv_range(mesh.face_handle(face))) {
+        const std::size_t i = root(slot[v.idx()]);
+        if (first == SIZE_MAX) first = i;
+        else parent[i] = first;
+      }
+    }
+  std::unordered_map<std::size_t, std::size_t> group;
+  std::vector<std::vector<VertexHandle>> out;
+  for (std::size_t i = 0; i < vertices.size(); ++i) {
+    const auto [it, added] = group.emplace(root(i), out.size());
+    if (added) out.emplace_back();
+    out[it->second].push_back(vertices[i]);
+  }
+  return out;
+}
+
+/// A face with its bounding sphere (centroid, largest distance to a corner).
+struct FaceSphere {
+  FaceHandle face;
+  Vec3 centre;
+  double radius;
+};
+
+/// A disk of the mesh around a tangle: the vertices it moves, its faces and its rim.
+struct Disk {
+  std::vector<VertexHandle> inner;  ///< moved; none on the mesh's boundary
+  std::vector<FaceHandle> faces;    ///< every face of an inner vertex
+  std::vector<VertexHandle> rim;    ///< the boundary loop of `faces`, in the faces' orientation
+  Vec3 normal;                      ///< unit vector area of the rim
+};
+
+class Untangler {
+ public:
+  Untangler(TriMesh& mesh, const ReferenceSurface& reference, double e_min, double e_max)
+      : mesh_(mesh), reference_(reference), e_min_(e_min), e_max_(e_max),
+        vertex_mark_(mesh.n_vertices(), 0), face_mark_(mesh.n_faces(), 0) {}
+
+  /// One round of vertex moves over the vertices of `pairs`; returns the moves kept.
+  std::size_t move_round(const Pairs& pairs) {
+    // Faces near a vertex: those whose centroid lies within the star's reach of it, from an index
+    // of the centroids at the start of the round, widened by the longest move the round may make.
+    const FaceSpheres spheres = face_spheres(mesh_);
+    const PointIndex index(spheres.centres);
+    double longest = 0;
+    for (auto e : mesh_.edges()) longest = std::max(longest, mesh_.calc_edge_length(e));
+    std::size_t kept = 0;
+    std::vector<std::uint32_t> near;
+    for (auto v : vertices_of(mesh_, pairs)) {
+      if (mesh_.is_boundary(v)) continue;
+      // A face crossing the star has its centroid within the star's reach (longest), its own
+      // radius (largest) and what either moved this round (at most `longest` per move) of v.
+      index.within(mesh_.point(v), 3 * longest + spheres.largest, near);
+      const std::size_t before = crossings(v, near);
+      if (before > 0 && try_moves(v, near, before)) ++kept;
+    }
+    return kept;
+  }
+
+  /// The crossing pairs now, given `pairs`, those before the moves since the last call: the pairs
+  /// near the moves are looked for again (find_self_intersections with a region), the others stand.
+  Pairs refresh(const Pairs& pairs, unsigned threads) {
+    if (!moved_) return pairs;
+    moved_ = false;
+    Pairs now = find_self_intersections(mesh_, threads, &moves_);
+    for (const auto& pair : pairs) {
+      bool near = false;
+      for (unsigned face : {pair.first, pair.second}) {
+        OpenMesh::VertexHandle c[3];
+        geom::face_vertices(mesh_, mesh_.face_handle(face), c);
+        const Vec3 centre = (mesh_.point(c[0]) + mesh_.point(c[1]) + mesh_.point(c[2])) / 3.0;
+        double radius = 0;
+        for (auto v : c) radius = std::max(radius, (mesh_.point(v) - centre).norm());
+        near = near || sphere_meets(moves_, centre, radius);
+      }
+      if (!near) now.push_back(pair);
+    }
+    std::sort(now.begin(), now.end());
+    return now;
+  }
+
+  /// Flattens each tangle of `pairs` in the smallest disk that works; returns the vertices moved.
+  std::size_t flatten(const Pairs& pairs) {
+    std::size_t moved = 0;
+    index_faces();
+    for (const std::vector<VertexHandle>& seeds : tangles(mesh_, pairs)) {
+      for (std::size_t rings = 1; rings <= kMaxPatchRings; ++rings) {
+        const std::optional<Disk> disk = disk_around(seeds, rings);
+        if (!disk) continue;
+        if (flatten_disk(*disk)) {
+          moved += disk->inner.size();
+          index_faces();
+          break;
+        }
+      }
+    }
+    return moved;
+  }
+
+ private:
+  // ---- vertex moves ----
+
+  /// Crossing pairs between v's faces and the faces `near` (or other faces of the star).
+  std::size_t crossings(VertexHandle v, const std::vector<std::uint32_t>& near) const {
+    auto sphere = [&](FaceHandle f) {
+      OpenMesh::VertexHandle c[3];
+      geom::face_vertices(mesh_, f, c);
+      const Vec3 centre = (mesh_.point(c[0]) + mesh_.point(c[1]) + mesh_.point(c[2])) / 3.0;
+      double radius = 0;
+      for (auto u : c) radius = std::max(radius, (mesh_.point(u) - centre).norm());
+      return FaceSphere{f, centre, radius};
+    };
+    std::vector<FaceSphere>& star = star_;
+    star.clear();
+    for (auto f : mesh_.vf_range(v)) star.push_back(sphere(f));
+    std::size_t n = 0;
+    for (std::uint32_t j : near) {
+      const FaceHandle g = mesh_.face_handle(j);
+      // A pair of star faces is counted from the one with the lower index.
+      const bool in_star = std::any_of(star.begin(), star.end(), [&](const FaceSphere& s) { return s.face == g; });
+      const FaceSphere other = sphere(g);
+      for (const FaceSphere& s : star) {
+        if (s.face == g || (in_star && g.idx() < s.face.idx())) continue;
+        const double reach = (s.radius + other.radius) * (1 + 1e-9);
+        if ((s.centre - other.centre).sqrnorm() > reach * reach) continue;
+        if (faces_cross(mesh_, s.face, g)) ++n;
+      }
+    }
+    return n;
+  }
+
+  bool outside(double length) const { return length < e_min_ || length > e_max_; }
+
+  std::size_t outside_edges(VertexHandle v) const {
+    std::size_t n = 0;
+    for (auto w : mesh_.vv_range(v)) n += outside((mesh_.point(w) - mesh_.point(v)).norm());
+    return n;
+  }
+
+  /// Of the candidate moves that fold nothing (geom::move_is_safe), leave no more of v's edges
+  /// outside the interval and lower the crossings of v's faces, keeps the one with the fewest
+  /// crossings, then the fewest edges outside, then the first.
+  bool try_moves(VertexHandle v, const std::vector<std::uint32_t>& near, std::size_t before) {
+    const Vec3 start = mesh_.point(v);
+    Vec3 centroid(0, 0, 0);
+    int valence = 0;
+    for (auto w : mesh_.vv_range(v)) centroid += mesh_.point(w), ++valence;
+    if (valence == 0) return false;
+    centroid /= valence;
+    const Vec3 normal = geom::vertex_normal(mesh_, v);
+    const std::size_t outside_before = outside_edges(v);
+    Vec3 best = start;
+    std::pair<std::size_t, std::size_t> best_score{before, outside_before};
+    for (double s : kSteps) {
+      const Vec3 target = start + s * (centroid - start);
+      // On the reference first (the surface stays the input's), else where the ring puts it.
+      for (const Vec3& p : {project_vertex(mesh_, v, target, normal, reference_), target}) {
+        if (p == start || !geom::move_is_safe(mesh_, v, p)) continue;
+        mesh_.point(v) = p;
+        const std::size_t out = outside_edges(v);
+        const std::pair<std::size_t, std::size_t> score{out <= outside_before ? crossings(v, near) : before, out};
+        mesh_.point(v) = start;
+        if (score.first < before && score < best_score) best = p, best_score = score;
+      }
+    }
+    if (best == start) return false;
+    mesh_.point(v) = best;
+    note_move(start, best);
+    return true;
+  }
+
+  // ---- flattening ----
+
+  /// The disk of the faces of the vertices within rings - 1 rings of `seeds`, when it is one: no
+  /// moved vertex on the mesh's boundary, one rim loop, Euler characteristic 1, a rim with a
+  /// non-zero vector area.
+  std::optional<Disk> disk_around(const std::vector<VertexHandle>& seeds, std::size_t rings) {
+    const int stamp = ++stamp_;
+    Disk disk;
+    disk.inner = seeds;
+    for (auto v : seeds) vertex_mark_[v.idx()] = stamp;
+    for (std::size_t begin = 0, r = 1; r < rings; ++r) {
+      const std::size_t end = disk.inner.size();
+      for (std::size_t i = begin; i < end; ++i)
+        for (auto w : mesh_.vv_range(disk.inner[i]))
+          if (vertex_mark_[w.idx()] != stamp) vertex_mark_[w.idx()] = stamp, disk.inner.push_back(w);
+      begin = end;
+    }
+    for (auto v : disk.inner) {
+      if (mesh_.is_boundary(v)) return std::nullopt;
+      for (auto f : mesh_.vf_range(v))
+        if (face_mark_[f.idx()] != stamp) face_mark_[f.idx()] = stamp, disk.faces.push_back(f);
+    }
+    // The rim: halfedges of disk faces whose opposite face is outside the disk, chained.
+    std::unordered_map<int, HalfedgeHandle> leaving;
+    std::size_t vertices = disk.inner.size();
+    for (auto f : disk.faces)
+      for (auto h : mesh_.fh_range(f)) {
+        const FaceHandle g = mesh_.opposite_face_handle(h);
+        if (g.is_valid() && face_mark_[g.idx()] == stamp) continue;
+        if (!leaving.emplace(mesh_.from_vertex_handle(h).idx(), h).second) return std::nullopt;  // pinched
+      }
+    if (leaving.empty()) return std::nullopt;
+    HalfedgeHandle h = leaving.begin()->second;
+    for (std::size_t k = 0; k < leaving.size(); ++k) {
+      disk.rim.push_back(mesh_.from_vertex_handle(h));
+      const auto next = leaving.find(mesh_.to_vertex_handle(h).idx());
+      if (next == leaving.end()) return std::nullopt;
+      h = next->second;
+    }
+    if (h != leaving.begin()->second) return std::nullopt;  // more than one loop
+    // Vertices of disk faces neither moved nor on the rim are held too; count them for Euler.
+    const int rim_stamp = ++stamp_;
+    for (auto v : disk.rim) vertex_mark_[v.idx()] = rim_stamp;
+    for (auto f : disk.faces)
+      for (auto v : mesh_.fv_range(f))
+        if (vertex_mark_[v.idx()] != stamp && vertex_mark_[v.idx()] != rim_stamp) return std::nullopt;
+    vertices += disk.rim.size();
+    const std::size_t edges = (3 * disk.faces.size() + disk.rim.size()) / 2;
+    if (vertices + disk.faces.size() != edges + 1) return std::nullopt;
+    Vec3 area(0, 0, 0);
+    for (std::size_t i = 0; i < disk.rim.size(); ++i)
+      area += mesh_.point(disk.rim[i]) % mesh_.point(disk.rim[(i + 1) % disk.rim.size()]);
+    if (area.norm() == 0) return std::nullopt;
+    disk.normal = area.normalized();
+    disk_stamp_ = stamp;
+    return disk;
+  }
+
+  /// Replaces the disk's inner vertices by a membrane (projected onto the reference when that
+  /// works) if the result has every disk face facing the rim's normal, none degenerate, no sharp
+  /// fold against the faces around the rim and no crossing. Returns whether it did.
+  bool flatten_disk(const Disk& disk) {
+    std::vector<Vec3> start(disk.inner.size());
+    for (std::size_t i = 0; i < disk.inner.size(); ++i) start[i] = mesh_.point(disk.inner[i]);
+    auto restore = [&] {
+      for (std::size_t i = 0; i < disk.inner.size(); ++i) mesh_.point(disk.inner[i]) = start[i];
+      return false;
+    };
+    // The membrane: each inner vertex at the mean of its neighbours (Gauss-Seidel sweeps until the
+    // largest move is below kMembraneSettled of the rim's mean edge).
+    double rim_edge = 0;
+    for (std::size_t i = 0; i < disk.rim.size(); ++i)
+      rim_edge += (mesh_.point(disk.rim[i]) - mesh_.point(disk.rim[(i + 1) % disk.rim.size()])).norm();
+    const double settled = kMembraneSettled * rim_edge / disk.rim.size();
+    for (int sweep = 0; sweep < kMembraneSweeps; ++sweep) {
+      double largest = 0;
+      for (auto v : disk.inner) {
+        Vec3 mean(0, 0, 0);
+        int n = 0;
+        for (auto w : mesh_.vv_range(v)) mean += mesh_.point(w), ++n;
+        mean /= n;
+        largest = std::max(largest, (mean - mesh_.point(v)).sqrnorm());
+        mesh_.point(v) = mean;
+      }
+      if (largest <= settled * settled) break;
+    }
+    // The membrane must stay near the reference: a pleat is flattened, a shape is not.
+    std::vector<Vec3> membrane(disk.inner.size()), projected(disk.inner.size());
+    for (std::size_t i = 0; i < disk.inner.size(); ++i) {
+      membrane[i] = mesh_.point(disk.inner[i]);
+      projected[i] = reference_.closest_point(membrane[i], disk.normal);
+      if ((projected[i] - membrane[i]).norm() > kMaxFlattening * e_min_) return restore();
+    }
+    // On the reference, when that keeps it sound; else the membrane itself.
+    auto keep = [&] {
+      for (std::size_t i = 0; i < disk.inner.size(); ++i) note_move(start[i], mesh_.point(disk.inner[i]));
+      return true;
+    };
+    for (std::size_t i = 0; i < disk.inner.size(); ++i) mesh_.point(disk.inner[i]) = projected[i];
+    if (sound(disk)) return keep();
+    for (std::size_t i = 0; i < disk.inner.size(); ++i) mesh_.point(disk.inner[i]) = membrane[i];
+    if (sound(disk)) return keep();
+    return restore();
+  }
+
+  /// Is the disk, as the mesh holds it now, free of folds, degenerate faces and crossings?
+  bool sound(const Disk& disk) {
+    for (auto f : disk.faces) {
+      OpenMesh::VertexHandle c[3];
+      geom::face_vertices(mesh_, f, c);
+      const Vec3 &a = mesh_.point(c[0]), &b = mesh_.point(c[1]), &d = mesh_.point(c[2]);
+      if ((geom::cross_normal(a, b, d) | disk.normal) <= 0 || geom::below_min_angle(a, b, d)) return false;
+      // Against the faces across the rim.
+      for (auto h : mesh_.fh_range(f)) {
+        const FaceHandle g = mesh_.opposite_face_handle(h);
+        if (!g.is_valid() || face_mark_[g.idx()] == disk_stamp_) continue;
+        if (!geom::normals_agree(geom::face_normal(mesh_, f), geom::face_normal(mesh_, g), geom::kMinAdjacentCos))
+          return false;
+      }
+    }
+    // Crossings: disk faces among themselves, and against the faces near them.
+    for (std::size_t i = 0; i < disk.faces.size(); ++i)
+      for (std::size_t j = i + 1; j < disk.faces.size(); ++j)
+        if (faces_cross(mesh_, disk.faces[i], disk.faces[j])) return false;
+    // The faces outside the disk have not moved since index_faces(): their spheres are current.
+    std::vector<std::uint32_t> near;
+    for (auto f : disk.faces) {
+      OpenMesh::VertexHandle c[3];
+      geom::face_vertices(mesh_, f, c);
+      const Vec3 centre = (mesh_.point(c[0]) + mesh_.point(c[1]) + mesh_.point(c[2])) / 3.0;
+      double radius = 0;
+      for (auto v : c) radius = std::max(radius, (mesh_.point(v) - centre).norm());
+      face_index_->within(centre, (radius + spheres_.largest) * (1 + 1e-9), near);
+      for (std::uint32_t j : near) {
+        const FaceHandle g = mesh_.face_handle(j);
+        if (face_mark_[j] == disk_stamp_) continue;
+        if (faces_cross(mesh_, f, g)) return false;
+      }
+    }
+    return true;
+  }
+
+  /// Grows the box of the moves since the last refresh() by a move from a to b.
+  void note_move(const Vec3& a, const Vec3& b) {
+    if (!moved_) moves_ = Box{a, a}, moved_ = true;
+    for (const Vec3& p : {a, b}) {
+      moves_.lo.minimize(p);
+      moves_.hi.maximize(p);
+    }
+  }
+
+  /// Indexes the faces' bounding spheres as the mesh holds them now.
+  void index_faces() {
+    spheres_ = face_spheres(mesh_);
+    face_index_.emplace(spheres_.centres);
+  }
+
+  TriMesh& mesh_;
+  const ReferenceSurface& reference_;
+  FaceSpheres spheres_;
+  std::optional<PointIndex> face_index_;
+  mutable std::vector<FaceSphere> star_;  ///< crossings()' scratch
+  double e_min_, e_max_;
+  std::vector<int> vertex_mark_, face_mark_;
+  Box moves_;
+  bool moved_ = false;
+  int stamp_ = 0;
+  int disk_stamp_ = 0;  ///< the mark of the faces of the last disk_around()
+};
+
+}  // namespace
+
+UntangleCounts untangle(TriMesh& mesh, const ReferenceSurface& reference, double e_min, double e_max,
+                        unsigned threads) {
+  UntangleCounts counts;
+  Pairs pairs = find_self_intersections(mesh, threads);
+  counts.pairs_before = pairs.size();
+  if (pairs.empty()) return counts;
+  Untangler untangler(mesh, reference, e_min, e_max);
+  auto move_rounds = [&] {
+    for (int r = 0; r < kMoveRounds && !pairs.empty(); ++r) {
+      const std::size_t kept = untangler.move_round(pairs);
+      counts.moved += kept;
+      if (kept == 0) break;
+      pairs = untangler.refresh(pairs, threads);
+    }
+  };
+  move_rounds();
+  if (!pairs.empty()) {
+    const std::size_t flattened = untangler.flatten(pairs);
+    counts.moved += flattened;
+    counts.flattened += flattened;
+    if (flattened > 0) {
+      pairs = untangler.refresh(pairs, threads);
+      move_rounds();
+    }
+  }
+  counts.pairs_after = pairs.size();
+  return counts;
+}
+
+}  // namespace remesh

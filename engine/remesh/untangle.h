@@ -1,0 +1,35 @@
+#pragma once
+/// \file untangle.h
+/// Not in the thesis: the last step of a run, after the feature snap, that moves apart faces that
+/// cross each other (self_intersections.h says how they come about). Two means, in turn:
+/// - vertex moves: a vertex of a crossing face goes part of the way to its ring's centroid,
+///   projected onto the reference or not, when that lowers its faces' crossings, folds nothing and
+///   leaves no more of its edges outside [e_min, e_max];
+/// - flattening: what single moves cannot mend (a pleat: a few rings of faces folded over each
+///   other, on a crumpled part of the reference) is replaced by a membrane. The vertices within a
+///   few rings of the tangle are placed where each is the mean of its neighbours, with the
+///   rest of the mesh held (a harmonic disk, whose shadow on the plane of its rim is a Tutte
+///   embedding, so it cannot fold when that shadow is valid), then projected onto the reference
+///   when that keeps it untangled. The disk grows ring by ring until one works.
+/// Measured (Table 4.2 setup): nefertiti's output had 14 crossing face pairs on its base where the
+/// input and CGAL's output have none.
+
+#include <cstddef>
+
+#include "core/mesh.h"
+#include "remesh/reference_surface.h"
+
+namespace remesh {
+
+struct UntangleCounts {
+  std::size_t pairs_before = 0, pairs_after = 0;  ///< crossing face pairs
+  std::size_t moved = 0;                          ///< vertex moves and flattened vertices
+  std::size_t flattened = 0;                      ///< of them, vertices of flattened disks
+};
+
+/// Moves the vertices of crossing faces of `mesh` apart (see the file comment). The mesh stays
+/// valid: no face folds or degenerates, the connectivity does not change.
+UntangleCounts untangle(TriMesh& mesh, const ReferenceSurface& reference, double e_min, double e_max,
+                        unsigned threads);
+
+}  // namespace remesh

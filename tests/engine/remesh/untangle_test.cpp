@@ -1,0 +1,176 @@
+// Crossing faces (self_intersections.h) and the step that moves them apart (untangle.h): the
+// detector against a brute-force test of every pair, the untangle on sheets folded through
+// themselves.
+#include <catch2/catch.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+#include <utility>
+#include <vector>
+
+#include "remesh/geometry.h"
+#include "remesh/reference_surface.h"
+#include "remesh/self_intersections.h"
+#include "remesh/untangle.h"
+#include "support/mesh_generators.h"
+#include "test_helpers.h"
+
+using namespace remesh;
+
+namespace {
+
+using Pairs = std::vector<std::pair<unsigned, unsigned>>;
+
+/// Every pair of faces sharing at most one vertex that triangles_cross, by testing all pairs.
+Pairs brute_force_pairs(const TriMesh& mesh) {
+  Pairs out;
+  for (unsigned i = 0; i < mesh.n_faces(); ++i)
+    for (unsigned j = i + 1; j < mesh.n_faces(); ++j) {
+      OpenMesh::VertexHandle x[3], y[3];
+      geom::face_vertices(mesh, mesh.face_handle(i), x);
+      geom::face_vertices(mesh, mesh.face_handle(j), y);
+      int shared = 0;
+      for (auto u : x)
+        for (auto w : y) shared += u == w;
+      if (shared < 2 && triangles_cross(mesh.point(x[0]), mesh.point(x[1]), mesh.point(x[2]), mesh.point(y[0]),
+                                        mesh.point(y[1]), mesh.point(y[2])))
+        out.emplace_back(i, j);
+    }
+  return out;
+}
+
+/// Moves every vertex by a random offset of up to `amount` in each coordinate.
+void jitter(TriMesh& mesh, double amount, std::mt19937& rng) {
+  std::uniform_real_distribution<double> d(-amount, amount);
+  for (auto v : mesh.vertices()) mesh.point(v) += Vec3(d(rng), d(rng), d(rng));
+}
+
+/// Sign of the z component of every face normal, +1 or -1 (0 when they disagree or one is flat).
+int facing(const TriMesh& mesh) {
+  int sign = 0;
+  for (auto f : mesh.faces()) {
+    const double z = geom::face_normal(mesh, f)[2];
+    const int s = z > 0 ? 1 : (z < 0 ? -1 : 0);
+    if (s == 0 || (sign != 0 && s != sign)) return 0;
+    sign = s;
+  }
+  return sign;
+}
+
+}  // namespace
+
+TEST_CASE("triangles_cross tells crossing triangles from touching and separate ones", "[untangle]") {
+  const Vec3 a(0, 0, 0), b(2, 0, 0), c(0, 2, 0);
+  // An edge of the second passes through the inside of the first.
+  CHECK(triangles_cross(a, b, c, Vec3(0.5, 0.5, -1), Vec3(0.6, 0.5, 1), Vec3(0.5, 1.5, 1)));
+  // The same lifted away.
+  CHECK_FALSE(triangles_cross(a, b, c, Vec3(0.5, 0.5, 4), Vec3(0.6, 0.5, 6), Vec3(0.5, 1.5, 6)));
+  // A common corner, and the opposite edge of the second through the first: a fold inside a star.
+  CHECK(triangles_cross(a, b, c, a, Vec3(1, 0.5, -1), Vec3(0.5, 1, 1)));
+  // A common corner, the second pointing away: they touch at the corner only.
+  CHECK_FALSE(triangles_cross(a, b, c, a, Vec3(-1, -1, 1), Vec3(-1, 0, -1)));
+  // A common edge never counts, even folded flat onto each other.
+  CHECK_FALSE(triangles_cross(a, b, c, a, b, Vec3(0.5, 0.5, 0)));
+  // The answer does not depend on the order of the triangles or of their corners.
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> d(-1, 1);
+  int crossing = 0;
+  for (int k = 0; k < 2000; ++k) {
+    Vec3 p[6];
+    for (auto& q : p) q = Vec3(d(rng), d(rng), d(rng));
+    const bool x = triangles_cross(p[0], p[1], p[2], p[3], p[4], p[5]);
+    CHECK(x == triangles_cross(p[3], p[4], p[5], p[0], p[1], p[2]));
+    CHECK(x == triangles_cross(p[1], p[2], p[0], p[5], p[3], p[4]));
+    CHECK(x == triangles_cross(p[0], p[2], p[1], p[3], p[5], p[4]));
+    crossing += x;
+  }
+  CHECK(crossing > 100);  // the random triangles do cross often
+}
+
+TEST_CASE("find_self_intersections finds the pairs a brute-force test finds", "[untangle]") {
+  std::mt19937 rng(11);
+  struct Case {
+    const char* name;
+    TriMesh mesh;
+    double jitter;
+  };
+  std::vector<Case> cases;
+  cases.push_back({"sphere, clean", test::make_icosphere(3, 10.0), 0.0});
+  cases.push_back({"sphere, crumpled", test::make_icosphere(3, 10.0), 1.5});
+  cases.push_back({"torus, crumpled", test::make_torus(40, 12, 3.0, 1.0), 0.25});
+  cases.push_back({"double torus, crumpled", test::make_double_torus(1.0, 2), 0.3});
+  for (auto& c : cases) {
+    INFO(c.name);
+    jitter(c.mesh, c.jitter, rng);
+    const Pairs expected = brute_force_pairs(c.mesh);
+    CHECK(find_self_intersections(c.mesh, 1) == expected);
+    CHECK(find_self_intersections(c.mesh, 2) == expected);
+    if (c.jitter == 0) {
+      CHECK(expected.empty());
+      continue;
+    }
+    CHECK(expected.size() > 10);
+    // With a region: the pairs with a face whose bounding sphere meets it.
+    const FaceSpheres spheres = face_spheres(c.mesh);
+    for (int k = 0; k < 5; ++k) {
+      const Vec3 at = c.mesh.point(c.mesh.vertex_handle(static_cast<unsigned>(k * 37 % c.mesh.n_vertices())));
+      const Box box{at - Vec3(1, 1, 1), at + Vec3(1, 2, 0.5)};
+      Pairs near;
+      for (const auto& [f, g] : expected)
+        if (sphere_meets(box, spheres.centres[f], spheres.radii[f]) ||
+            sphere_meets(box, spheres.centres[g], spheres.radii[g]))
+          near.emplace_back(f, g);
+      CHECK(find_self_intersections(c.mesh, 2, &box) == near);
+    }
+  }
+}
+
+TEST_CASE("untangle removes the crossings of crumpled patches, folds nothing new, leaves the rest alone",
+          "[untangle]") {
+  // A flat hex lattice (every edge 1.5, inside [1.2, 1.8]) is the reference. In the mesh a patch is
+  // crumpled at random (vertices within 3 of a point moved by up to one edge across and 0.4 up or
+  // down), so that a few rings of faces lie folded through each other, as on nefertiti's base.
+  // Crossing faces need faces turned upside down: a surface whose faces all face up is a height
+  // field, which cannot cross itself.
+  const TriMesh reference = test::make_hex_lattice_patch(20, 20, 1.5);
+  const ReferenceSurface surface(reference);
+  const int side = facing(reference);
+  REQUIRE(side != 0);
+  const Vec3 centre(15, 13, 0);
+  int tangled = 0, by_moves = 0, by_flattening = 0;
+  for (unsigned seed = 1; seed <= 12; ++seed) {
+    INFO("seed " << seed);
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<double> across(-1.5, 1.5), up(-0.4, 0.4);
+    TriMesh mesh = reference;
+    for (auto v : mesh.vertices())
+      if ((reference.point(v) - centre).norm() < 3) mesh.point(v) += Vec3(across(rng), across(rng), up(rng));
+    const std::size_t before = find_self_intersections(mesh, 1).size();
+    if (before == 0) continue;  // this draw did not tangle; `tangled` counts those that did
+    ++tangled;
+    auto upside_down = [&] {
+      std::size_t n = 0;
+      for (auto f : mesh.faces()) n += geom::face_normal(mesh, f)[2] * side <= 0;
+      return n;
+    };
+    const std::size_t away = upside_down();
+    const UntangleCounts counts = untangle(mesh, surface, 1.2, 1.8, 1);
+    CHECK(counts.pairs_before == before);
+    CHECK(counts.pairs_after == 0);
+    CHECK(find_self_intersections(mesh, 1).empty());
+    CHECK(upside_down() <= away);
+    if (upside_down() == 0) CHECK(test::check_mesh_valid(mesh) == "");
+    (counts.flattened > 0 ? by_flattening : by_moves) += 1;
+    for (auto v : mesh.vertices()) {
+      // Near the reference plane (within the flattening limit, e_min)...
+      CHECK(std::abs(mesh.point(v)[2]) <= 1.2);
+      // ...and the lattice far from the tangle untouched, its boundary included.
+      if ((reference.point(v) - centre).norm() > 12 || mesh.is_boundary(v)) CHECK(mesh.point(v) == reference.point(v));
+    }
+  }
+  CHECK(tangled >= 6);
+  // Both means were needed: some tangles yield to vertex moves, others only to a flattened disk.
+  CHECK(by_moves > 0);
+  CHECK(by_flattening > 0);
+}
