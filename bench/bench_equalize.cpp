@@ -29,6 +29,7 @@
 #include "bench_common.h"
 #include "remesh/equalize.h"
 #include "remesh/geometry.h"
+#include "remesh/self_intersections.h"
 #ifdef REMESH_BENCH_HAS_CGAL
 #include "cgal_isotropic.h"
 #endif
@@ -168,13 +169,13 @@ void print_thin_parts(const TriMesh& input, const TriMesh& output, const Options
 
 /// The quality row printed for each remesher.
 void print_quality(const char* who, const TriMesh& input, const TriMesh& output, const bench::Topology& topo_in,
-                   const ChildResult& r, const Options& o) {
+                   std::size_t crossings_in, const ChildResult& r, const Options& o) {
   const IterationStats s = measure(output, kEmin, kEmax, o.threads);
   const bench::Topology t = bench::topology_of(output);
   const double h = bench::hausdorff_distance(input, output, o.samples, o.threads) / bench::bbox_diagonal(input);
   std::printf("%-5s: inside %.3f %% (small %zu, big %zu), regular %.2f %%, mean %.4f, dev %.4f, V %zu, F %zu, "
               "Hausdorff %.4f %% of bbox diagonal, %d it (%s), %.4f s/it, total %.3f s, peak %.1f MiB, "
-              "topology %s (euler %ld, boundary loops %zu, components %zu)\n",
+              "topology %s (euler %ld, boundary loops %zu, components %zu), crossing face pairs %zu (input %zu)\n",
               who, 100 * s.inside_fraction, s.small, s.big, s.regular_percent, s.mean, s.deviation, output.n_vertices(),
               output.n_faces(), 100 * h, r.iterations, r.outcome.c_str(),
               r.iterations ? r.seconds / r.iterations : 0.0, r.seconds, r.peak_mib,
@@ -182,17 +183,19 @@ void print_quality(const char* who, const TriMesh& input, const TriMesh& output,
                t.components == topo_in.components)
                   ? "preserved"
                   : "CHANGED",
-              t.euler, t.boundary_loops, t.components);
+              t.euler, t.boundary_loops, t.components, find_self_intersections(output, o.threads).size(), crossings_in);
 }
 
 void run_setup(const std::string& path, const char* setup, double mean_edge, const Options& o, const fs::path& dir) {
   const std::string name = fs::path(path).filename().string() + "_" + setup;
   const std::string scaled = (dir / (name + "_in.off")).string();
   bench::Topology topo_in;
+  std::size_t crossings_in = 0;
   {
     TriMesh mesh = bench::load_mesh(path);
     const double factor = bench::scale_to_mean_edge(mesh, mean_edge);
     topo_in = bench::topology_of(mesh);
+    crossings_in = find_self_intersections(mesh, o.threads).size();
     bench::write_off(mesh, scaled);
     std::printf("\n== %s, setup %s: scaled by %.6g to mean edge %.2f; target [%.1f, %.1f], k=2, pr=0, f=0.5, up to %d "
                 "iterations%s; input V %zu F %zu (euler %ld, boundary loops %zu, components %zu)\n",
@@ -225,7 +228,7 @@ void run_setup(const std::string& path, const char* setup, double mean_edge, con
     std::printf("ours : FAILED\n");
   } else {
     const TriMesh output = bench::load_mesh(ours_out);
-    print_quality("ours", input, output, topo_in, ours, o);
+    print_quality("ours", input, output, topo_in, crossings_in, ours, o);
     print_thin_parts(input, output, o);
   }
 #ifdef REMESH_BENCH_HAS_CGAL
@@ -238,7 +241,7 @@ void run_setup(const std::string& path, const char* setup, double mean_edge, con
     if (!cgal.ok) {
       std::printf("cgal : FAILED\n");
     } else {
-      print_quality("cgal", input, bench::load_mesh(cgal_out), topo_in, cgal, o);
+      print_quality("cgal", input, bench::load_mesh(cgal_out), topo_in, crossings_in, cgal, o);
       if (ours.ok)
         std::printf("ratio ours/cgal: time %.2fx, peak memory %.2fx\n", ours.seconds / cgal.seconds,
                     ours.peak_mib / cgal.peak_mib);
