@@ -104,7 +104,10 @@ bool sphere_meets(const Box& box, const Vec3& centre, double radius, double grow
     const double d = std::max({below, above, 0.0});
     d2 += d * d;
   }
-  return d2 <= radius * radius;
+  // With a margin: for a sphere through a corner of the box, rounding can put the corner just
+  // outside the sphere computed from it.
+  const double reach = radius * (1 + 1e-9) + 1e-300;
+  return d2 <= reach * reach;
 }
 
 std::vector<std::pair<unsigned, unsigned>> find_self_intersections(const TriMesh& mesh, unsigned threads,

@@ -337,17 +337,18 @@ class Untangler {
     return restore();
   }
 
-  /// Is the disk, as the mesh holds it now, free of folds, degenerate faces and crossings?
+  /// Is the disk, as the mesh holds it now, free of folds (a face turned away from the rim's
+  /// normal, two adjacent faces sharper than kMinAdjacentCos), degenerate faces and crossings?
   bool sound(const Disk& disk) {
     for (auto f : disk.faces) {
       OpenMesh::VertexHandle c[3];
       geom::face_vertices(mesh_, f, c);
       const Vec3 &a = mesh_.point(c[0]), &b = mesh_.point(c[1]), &d = mesh_.point(c[2]);
       if ((geom::cross_normal(a, b, d) | disk.normal) <= 0 || geom::below_min_angle(a, b, d)) return false;
-      // Against the faces across the rim.
+      // No sharp fold against a neighbour, in the disk (each pair once) or across the rim.
       for (auto h : mesh_.fh_range(f)) {
         const FaceHandle g = mesh_.opposite_face_handle(h);
-        if (!g.is_valid() || face_mark_[g.idx()] == disk_stamp_) continue;
+        if (!g.is_valid() || (face_mark_[g.idx()] == disk_stamp_ && g.idx() < f.idx())) continue;
         if (!geom::normals_agree(geom::face_normal(mesh_, f), geom::face_normal(mesh_, g), geom::kMinAdjacentCos))
           return false;
       }

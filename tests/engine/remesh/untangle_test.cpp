@@ -174,3 +174,47 @@ TEST_CASE("untangle removes the crossings of crumpled patches, folds nothing new
   CHECK(by_moves > 0);
   CHECK(by_flattening > 0);
 }
+
+TEST_CASE("untangle makes no pair of adjacent faces sharper than an edit may", "[untangle]") {
+  // A rippled reference (not aligned with the edges), crumpled at random as above: whatever the
+  // untangle moves, an edge whose faces met at less than kMinAdjacentCos before may not be sharper
+  // after, and none may become that sharp. Over many draws some tangles are flattened into disks
+  // on the ripples, where faces of the disk could otherwise fold against each other.
+  using geom::kMinAdjacentCos;
+  auto edge_cos = [](const TriMesh& m) {
+    std::vector<double> cos(m.n_edges(), 1.0);
+    for (auto e : m.edges()) {
+      if (m.is_boundary(e)) continue;
+      const auto h = m.halfedge_handle(e, 0);
+      const Vec3 a = geom::face_normal(m, m.face_handle(h)), b = geom::face_normal(m, m.opposite_face_handle(h));
+      cos[e.idx()] = (a | b) / (a.norm() * b.norm());
+    }
+    return cos;
+  };
+  const Vec3 centre(15, 13, 0);
+  int flattened = 0;
+  for (double amplitude : {0.6, 1.2}) {
+    TriMesh reference = test::make_hex_lattice_patch(20, 20, 1.5);
+    for (auto v : reference.vertices()) {
+      Vec3& p = reference.point(v);
+      p[2] = amplitude * std::sin(2.1 * p[0] + 0.7 * p[1]);
+    }
+    const ReferenceSurface surface(reference);
+    for (unsigned seed = 1; seed <= 40; ++seed) {
+      INFO("amplitude " << amplitude << ", seed " << seed);
+      std::mt19937 rng(seed);
+      std::uniform_real_distribution<double> across(-1.5, 1.5), up(-0.4, 0.4);
+      TriMesh mesh = reference;
+      for (auto v : mesh.vertices())
+        if ((reference.point(v) - centre).norm() < 3.5) mesh.point(v) += Vec3(across(rng), across(rng), up(rng));
+      const std::vector<double> before = edge_cos(mesh);
+      const std::size_t pairs = find_self_intersections(mesh, 1).size();
+      const UntangleCounts counts = untangle(mesh, surface, 1.2, 1.8, 1);
+      CHECK(counts.pairs_after <= pairs);
+      flattened += counts.flattened > 0;
+      const std::vector<double> after = edge_cos(mesh);
+      for (std::size_t e = 0; e < after.size(); ++e) CHECK(after[e] >= std::min(kMinAdjacentCos, before[e]) - 1e-12);
+    }
+  }
+  CHECK(flattened >= 5);
+}
