@@ -129,10 +129,16 @@ constexpr int kUntangleRounds = 3;
 
 void untangle_and_mend(TriMesh& mesh, const ReferenceSurface& reference, const Params& params,
                        std::vector<NeighbourCache>& caches, IterationStats& row) {
+  // The row describes the mesh before the feature snap, which takes no edge out of the interval.
+  const std::size_t outside_before = row.small + row.big;
   for (int round = 1; round <= kUntangleRounds; ++round) {
     const UntangleCounts u = untangle(mesh, reference, params.e_min, params.e_max, params.threads);
     row.cleanup_fixes += u.moved;
     if (u.moved == 0 || round == kUntangleRounds) return;
+    // Nothing to mend when no more edges are outside than before (the vertex moves never take
+    // one out; a flattened disk may).
+    const IterationStats now = measure(mesh, params.e_min, params.e_max, params.threads);
+    if (now.small + now.big <= outside_before) return;
     CleanupOptions options;
     options.rounds = kFinalCleanupRounds;
     options.patch_budget = final_patch_budget(mesh);
