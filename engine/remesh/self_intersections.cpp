@@ -9,7 +9,6 @@
 
 #include "core/parallel.h"
 #include "remesh/geometry.h"
-#include "remesh/point_index.h"
 
 namespace remesh {
 
@@ -110,6 +109,128 @@ bool sphere_meets(const Box& box, const Vec3& centre, double radius, double grow
   return d2 <= reach * reach;
 }
 
+namespace {
+
+/// The broad phase of find_self_intersections: calls test(i, j, block) once for every pair of
+/// `faces` whose bounding spheres overlap (and for a few more), from parallel blocks numbered
+/// 0 .. out.size() - 1 (out is resized to hold one result vector per block).
+/// A uniform grid with cells of side h, twice the 99th percentile of the radii: two faces whose
+/// radii are at most h / 2 and whose spheres overlap have their centres within h of each other in
+/// every coordinate, so in the same cell or in adjacent ones, and each pair of adjacent cells is
+/// visited once. The few faces with a larger radius are tested against every cell within their
+/// reach and against each other.
+template <typename Test, typename Out>
+void for_overlapping_spheres(const FaceSpheres& spheres, const std::vector<unsigned>& faces, unsigned threads,
+                             Test&& test, std::vector<Out>& out) {
+  const std::size_t n = faces.size();
+  auto overlap = [&](unsigned i, unsigned j) {
+    const double r = (spheres.radii[i] + spheres.radii[j]) * (1 + 1e-9);
+    return (spheres.centres[i] - spheres.centres[j]).sqrnorm() <= r * r;
+  };
+  if (n == 0) {
+    out.clear();
+    return;
+  }
+  std::vector<double> radii(n);
+  Vec3 lo = spheres.centres[faces[0]], hi = lo;
+  for (std::size_t k = 0; k < n; ++k) {
+    radii[k] = spheres.radii[faces[k]];
+    lo.minimize(spheres.centres[faces[k]]);
+    hi.maximize(spheres.centres[faces[k]]);
+  }
+  const auto p99 = radii.begin() + static_cast<std::ptrdiff_t>(n * 99 / 100);
+  std::nth_element(radii.begin(), p99, radii.end());
+  // At most 2^20 cells along an axis (keys of 21 bits per axis).
+  const double extent = std::max({hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]});
+  double h = std::max(2 * *p99, extent / (1 << 20));
+  if (!(h > 0)) h = 1;
+  auto coord = [&](double x, int axis) {
+    return static_cast<std::int64_t>(std::clamp(std::floor((x - lo[axis]) / h), 0.0, double((1 << 21) - 1)));
+  };
+  auto key_of = [](std::int64_t x, std::int64_t y, std::int64_t z) {
+    return static_cast<std::uint64_t>(x) << 42 | static_cast<std::uint64_t>(y) << 21 | static_cast<std::uint64_t>(z);
+  };
+  std::vector<std::pair<std::uint64_t, unsigned>> entries;
+  std::vector<unsigned> big;
+  entries.reserve(n);
+  for (unsigned f : faces) {
+    if (spheres.radii[f] > h / 2) {
+      big.push_back(f);
+      continue;
+    }
+    const Vec3& c = spheres.centres[f];
+    entries.emplace_back(key_of(coord(c[0], 0), coord(c[1], 1), coord(c[2], 2)), f);
+  }
+  std::sort(entries.begin(), entries.end());
+  std::vector<std::uint64_t> keys;
+  std::vector<std::size_t> begins;
+  for (std::size_t e = 0; e < entries.size(); ++e)
+    if (e == 0 || entries[e].first != entries[e - 1].first) keys.push_back(entries[e].first), begins.push_back(e);
+  begins.push_back(entries.size());
+  auto cell = [&](std::uint64_t key) -> std::ptrdiff_t {
+    const auto it = std::lower_bound(keys.begin(), keys.end(), key);
+    return it != keys.end() && *it == key ? it - keys.begin() : -1;
+  };
+  constexpr std::size_t kBlock = 256;
+  const std::size_t cell_blocks = block_count(keys.size(), kBlock);
+  out.assign(cell_blocks + big.size(), Out());
+  // Small faces: each cell with itself and its 13 neighbours that come after it.
+  parallel_blocks(keys.size(), kBlock, threads, [&](std::size_t b, std::size_t e, std::size_t block) {
+    for (std::size_t c = b; c < e; ++c) {
+      const std::uint64_t key = keys[c];
+      const std::int64_t x = key >> 42, y = key >> 21 & 0x1FFFFF, z = key & 0x1FFFFF;
+      for (std::size_t u = begins[c]; u < begins[c + 1]; ++u)
+        for (std::size_t v = u + 1; v < begins[c + 1]; ++v)
+          if (overlap(entries[u].second, entries[v].second)) test(entries[u].second, entries[v].second, block);
+      for (int dx = 0; dx <= 1; ++dx)
+        for (int dy = dx == 0 ? 0 : -1; dy <= 1; ++dy)
+          for (int dz = dx == 0 && dy == 0 ? 1 : -1; dz <= 1; ++dz) {
+            if (x + dx < 0 || y + dy < 0 || z + dz < 0 || y + dy >= (1 << 21) || z + dz >= (1 << 21)) continue;
+            const std::ptrdiff_t d = cell(key_of(x + dx, y + dy, z + dz));
+            if (d < 0) continue;
+            for (std::size_t u = begins[c]; u < begins[c + 1]; ++u)
+              for (std::size_t v = begins[d]; v < begins[d + 1]; ++v)
+                if (overlap(entries[u].second, entries[v].second)) test(entries[u].second, entries[v].second, block);
+          }
+    }
+  });
+  // Big faces: against the small faces of the cells within their reach, and against the big faces
+  // after them.
+  parallel_blocks(big.size(), 1, threads, [&](std::size_t b, std::size_t e, std::size_t) {
+    for (std::size_t k = b; k < e; ++k) {
+      const unsigned f = big[k];
+      const std::size_t block = cell_blocks + k;
+      const Vec3& c = spheres.centres[f];
+      const double reach = spheres.radii[f] + h / 2;
+      std::int64_t from[3], to[3];
+      double cells = 1;
+      for (int a = 0; a < 3; ++a) {
+        from[a] = coord(c[a] - reach, a), to[a] = coord(c[a] + reach, a);
+        cells *= double(to[a] - from[a] + 1);
+      }
+      auto visit = [&](std::size_t d) {
+        for (std::size_t v = begins[d]; v < begins[d + 1]; ++v)
+          if (overlap(f, entries[v].second)) test(f, entries[v].second, block);
+      };
+      if (cells > double(keys.size())) {
+        for (std::size_t d = 0; d < keys.size(); ++d) {
+          const std::int64_t x = keys[d] >> 42, y = keys[d] >> 21 & 0x1FFFFF, z = keys[d] & 0x1FFFFF;
+          if (x >= from[0] && x <= to[0] && y >= from[1] && y <= to[1] && z >= from[2] && z <= to[2]) visit(d);
+        }
+      } else {
+        for (std::int64_t x = from[0]; x <= to[0]; ++x)
+          for (std::int64_t y = from[1]; y <= to[1]; ++y)
+            for (std::int64_t z = from[2]; z <= to[2]; ++z)
+              if (const std::ptrdiff_t d = cell(key_of(x, y, z)); d >= 0) visit(static_cast<std::size_t>(d));
+      }
+      for (std::size_t l = k + 1; l < big.size(); ++l)
+        if (overlap(f, big[l])) test(f, big[l], block);
+    }
+  });
+}
+
+}  // namespace
+
 std::vector<std::pair<unsigned, unsigned>> find_self_intersections(const TriMesh& mesh, unsigned threads,
                                                                    const Box* region) {
   const FaceSpheres spheres = face_spheres(mesh);
@@ -131,32 +252,12 @@ std::vector<std::pair<unsigned, unsigned>> find_self_intersections(const TriMesh
     faces.resize(mesh.n_faces());
     std::iota(faces.begin(), faces.end(), 0u);
   }
-  std::vector<Vec3> centres(faces.size());
-  for (std::size_t k = 0; k < faces.size(); ++k) centres[k] = spheres.centres[faces[k]];
-  const PointIndex index(std::move(centres));
-  const std::size_t n = faces.size();
-  constexpr std::size_t kBlock = 1024;
-  std::vector<std::vector<std::pair<unsigned, unsigned>>> found(block_count(n, kBlock));
-  parallel_blocks(n, kBlock, threads, [&](std::size_t begin, std::size_t end, std::size_t block) {
-    std::vector<std::uint32_t> near;
-    for (std::size_t k = begin; k < end; ++k) {
-      // A pair whose spheres overlap is found from the face with the larger sphere (the lower
-      // index on a tie), whose centre lies within twice its radius of the other's.
-      const unsigned i = faces[k];
-      const double ri = spheres.radii[i];
-      index.within(spheres.centres[i], 2 * ri * (1 + 1e-9), near);
-      for (std::uint32_t l : near) {
-        const unsigned j = faces[l];
-        const double rj = spheres.radii[j];
-        if (j == i || rj > ri || (rj == ri && j < i)) continue;
-        if (region && !in_region[i] && !in_region[j]) continue;
-        const double r = ri + rj;
-        if ((spheres.centres[i] - spheres.centres[j]).sqrnorm() > r * r) continue;
-        if (corners_cross(mesh, spheres.corners[i], spheres.corners[j]))
-          found[block].emplace_back(std::min(i, j), std::max(i, j));
-      }
-    }
-  });
+  std::vector<std::vector<std::pair<unsigned, unsigned>>> found;
+  for_overlapping_spheres(spheres, faces, threads, [&](unsigned i, unsigned j, std::size_t block) {
+    if (region && !in_region[i] && !in_region[j]) return;
+    if (corners_cross(mesh, spheres.corners[i], spheres.corners[j]))
+      found[block].emplace_back(std::min(i, j), std::max(i, j));
+  }, found);
   std::vector<std::pair<unsigned, unsigned>> pairs;
   for (auto& b : found) pairs.insert(pairs.end(), b.begin(), b.end());
   std::sort(pairs.begin(), pairs.end());

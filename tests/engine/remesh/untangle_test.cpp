@@ -100,6 +100,17 @@ TEST_CASE("find_self_intersections finds the pairs a brute-force test finds", "[
   cases.push_back({"sphere, crumpled", test::make_icosphere(3, 10.0), 1.5});
   cases.push_back({"torus, crumpled", test::make_torus(40, 12, 3.0, 1.0), 0.25});
   cases.push_back({"double torus, crumpled", test::make_double_torus(1.0, 2), 0.3});
+  {
+    // Faces of very different sizes: two large triangles through a sphere and through each other
+    // (the detector treats faces far above the usual size apart).
+    TriMesh m = test::make_icosphere(3, 10.0);
+    auto add = [&](const Vec3& a, const Vec3& b, const Vec3& c) {
+      m.add_face(m.add_vertex(a), m.add_vertex(b), m.add_vertex(c));
+    };
+    add(Vec3(-30, -20, 0.5), Vec3(30, -20, -0.5), Vec3(0, 30, 0.3));
+    add(Vec3(0.2, -25, -25), Vec3(-0.3, 25, -25), Vec3(0.1, 0, 30));
+    cases.push_back({"sphere with two large triangles through it", std::move(m), 0.3});
+  }
   for (auto& c : cases) {
     INFO(c.name);
     jitter(c.mesh, c.jitter, rng);
