@@ -30,6 +30,14 @@ bool segment_crosses(const Vec3& p, const Vec3& q, const Vec3& a, const Vec3& b,
 
 }  // namespace
 
+Sphere face_sphere(const TriMesh& mesh, OpenMesh::FaceHandle f) {
+  OpenMesh::VertexHandle c[3];
+  geom::face_vertices(mesh, f, c);
+  Sphere s{(mesh.point(c[0]) + mesh.point(c[1]) + mesh.point(c[2])) / 3.0, 0};
+  for (auto v : c) s.radius = std::max(s.radius, (mesh.point(v) - s.centre).norm());
+  return s;
+}
+
 FaceSpheres face_spheres(const TriMesh& mesh) {
   FaceSpheres s;
   s.centres.resize(mesh.n_faces());
@@ -39,12 +47,10 @@ FaceSpheres face_spheres(const TriMesh& mesh) {
     OpenMesh::VertexHandle c[3];
     geom::face_vertices(mesh, f, c);
     for (int k = 0; k < 3; ++k) s.corners[f.idx()][k] = c[k].idx();
-    const Vec3 &a = mesh.point(c[0]), &b = mesh.point(c[1]), &d = mesh.point(c[2]);
-    const Vec3 centre = (a + b + d) / 3.0;
-    const double r = std::sqrt(std::max({(a - centre).sqrnorm(), (b - centre).sqrnorm(), (d - centre).sqrnorm()}));
-    s.centres[f.idx()] = centre;
-    s.radii[f.idx()] = r;
-    s.largest = std::max(s.largest, r);
+    const Sphere sphere = face_sphere(mesh, f);
+    s.centres[f.idx()] = sphere.centre;
+    s.radii[f.idx()] = sphere.radius;
+    s.largest = std::max(s.largest, sphere.radius);
   }
   return s;
 }
@@ -124,8 +130,7 @@ void for_overlapping_spheres(const FaceSpheres& spheres, const std::vector<unsig
                              Test&& test, std::vector<Out>& out) {
   const std::size_t n = faces.size();
   auto overlap = [&](unsigned i, unsigned j) {
-    const double r = (spheres.radii[i] + spheres.radii[j]) * (1 + 1e-9);
-    return (spheres.centres[i] - spheres.centres[j]).sqrnorm() <= r * r;
+    return spheres_overlap({spheres.centres[i], spheres.radii[i]}, {spheres.centres[j], spheres.radii[j]});
   };
   if (n == 0) {
     out.clear();
@@ -149,6 +154,11 @@ void for_overlapping_spheres(const FaceSpheres& spheres, const std::vector<unsig
   };
   auto key_of = [](std::int64_t x, std::int64_t y, std::int64_t z) {
     return static_cast<std::uint64_t>(x) << 42 | static_cast<std::uint64_t>(y) << 21 | static_cast<std::uint64_t>(z);
+  };
+  auto cell_of = [](std::uint64_t key) {
+    return std::array<std::int64_t, 3>{static_cast<std::int64_t>(key >> 42),
+                                       static_cast<std::int64_t>(key >> 21 & 0x1FFFFF),
+                                       static_cast<std::int64_t>(key & 0x1FFFFF)};
   };
   std::vector<std::pair<std::uint64_t, unsigned>> entries;
   std::vector<unsigned> big;
@@ -178,7 +188,7 @@ void for_overlapping_spheres(const FaceSpheres& spheres, const std::vector<unsig
   parallel_blocks(keys.size(), kBlock, threads, [&](std::size_t b, std::size_t e, std::size_t block) {
     for (std::size_t c = b; c < e; ++c) {
       const std::uint64_t key = keys[c];
-      const std::int64_t x = key >> 42, y = key >> 21 & 0x1FFFFF, z = key & 0x1FFFFF;
+      const auto [x, y, z] = cell_of(key);
       for (std::size_t u = begins[c]; u < begins[c + 1]; ++u)
         for (std::size_t v = u + 1; v < begins[c + 1]; ++v)
           if (overlap(entries[u].second, entries[v].second)) test(entries[u].second, entries[v].second, block);
@@ -214,7 +224,7 @@ void for_overlapping_spheres(const FaceSpheres& spheres, const std::vector<unsig
       };
       if (cells > double(keys.size())) {
         for (std::size_t d = 0; d < keys.size(); ++d) {
-          const std::int64_t x = keys[d] >> 42, y = keys[d] >> 21 & 0x1FFFFF, z = keys[d] & 0x1FFFFF;
+          const auto [x, y, z] = cell_of(keys[d]);
           if (x >= from[0] && x <= to[0] && y >= from[1] && y <= to[1] && z >= from[2] && z <= to[2]) visit(d);
         }
       } else {

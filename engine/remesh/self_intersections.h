@@ -23,7 +23,20 @@ bool triangles_cross(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d,
 /// triangles_cross for faces f and g of `mesh`; faces with an edge in common never cross.
 bool faces_cross(const TriMesh& mesh, OpenMesh::FaceHandle f, OpenMesh::FaceHandle g);
 
-/// Per face index: the centroid and the largest distance from it to a corner (a bounding sphere).
+/// A bounding sphere of a face: its centroid and the largest distance from it to a corner.
+struct Sphere {
+  Vec3 centre;
+  double radius = 0;
+};
+Sphere face_sphere(const TriMesh& mesh, OpenMesh::FaceHandle f);
+
+/// Do the spheres overlap (touching counts, with a margin of 1e-9 of the radii for rounding)?
+inline bool spheres_overlap(const Sphere& a, const Sphere& b) {
+  const double reach = (a.radius + b.radius) * (1 + 1e-9);
+  return (a.centre - b.centre).sqrnorm() <= reach * reach;
+}
+
+/// Per face index: its face_sphere() and corners.
 struct FaceSpheres {
   std::vector<Vec3> centres;
   std::vector<double> radii;

@@ -78,12 +78,19 @@ std::vector<std::vector<VertexHandle>> tangles(const TriMesh& mesh, const Pairs&
   return out;
 }
 
-/// A face with its bounding sphere (centroid, largest distance to a corner).
+/// A face with its face_sphere().
 struct FaceSphere {
   FaceHandle face;
-  Vec3 centre;
-  double radius;
+  Sphere sphere;
 };
+
+/// The mean of v's neighbours; v itself when it has none.
+Vec3 ring_centroid(const TriMesh& mesh, VertexHandle v) {
+  Vec3 sum(0, 0, 0);
+  int n = 0;
+  for (auto w : mesh.vv_range(v)) sum += mesh.point(w), ++n;
+  return n > 0 ? sum / n : mesh.point(v);
+}
 
 /// A disk of the mesh around a tangle: the vertices it moves, its faces and its rim.
 struct Disk {
@@ -129,12 +136,8 @@ class Untangler {
     for (const auto& pair : pairs) {
       bool near = false;
       for (unsigned face : {pair.first, pair.second}) {
-        OpenMesh::VertexHandle c[3];
-        geom::face_vertices(mesh_, mesh_.face_handle(face), c);
-        const Vec3 centre = (mesh_.point(c[0]) + mesh_.point(c[1]) + mesh_.point(c[2])) / 3.0;
-        double radius = 0;
-        for (auto v : c) radius = std::max(radius, (mesh_.point(v) - centre).norm());
-        near = near || sphere_meets(moves_, centre, radius);
+        const Sphere s = face_sphere(mesh_, mesh_.face_handle(face));
+        near = near || sphere_meets(moves_, s.centre, s.radius);
       }
       if (!near) now.push_back(pair);
     }
@@ -165,28 +168,18 @@ class Untangler {
 
   /// Crossing pairs between v's faces and the faces `near` (or other faces of the star).
   std::size_t crossings(VertexHandle v, const std::vector<std::uint32_t>& near) const {
-    auto sphere = [&](FaceHandle f) {
-      OpenMesh::VertexHandle c[3];
-      geom::face_vertices(mesh_, f, c);
-      const Vec3 centre = (mesh_.point(c[0]) + mesh_.point(c[1]) + mesh_.point(c[2])) / 3.0;
-      double radius = 0;
-      for (auto u : c) radius = std::max(radius, (mesh_.point(u) - centre).norm());
-      return FaceSphere{f, centre, radius};
-    };
     std::vector<FaceSphere>& star = star_;
     star.clear();
-    for (auto f : mesh_.vf_range(v)) star.push_back(sphere(f));
+    for (auto f : mesh_.vf_range(v)) star.push_back({f, face_sphere(mesh_, f)});
     std::size_t n = 0;
     for (std::uint32_t j : near) {
       const FaceHandle g = mesh_.face_handle(j);
       // A pair of star faces is counted from the one with the lower index.
       const bool in_star = std::any_of(star.begin(), star.end(), [&](const FaceSphere& s) { return s.face == g; });
-      const FaceSphere other = sphere(g);
+      const Sphere other = face_sphere(mesh_, g);
       for (const FaceSphere& s : star) {
         if (s.face == g || (in_star && g.idx() < s.face.idx())) continue;
-        const double reach = (s.radius + other.radius) * (1 + 1e-9);
-        if ((s.centre - other.centre).sqrnorm() > reach * reach) continue;
-        if (faces_cross(mesh_, s.face, g)) ++n;
+        if (spheres_overlap(s.sphere, other) && faces_cross(mesh_, s.face, g)) ++n;
       }
     }
     return n;
@@ -205,11 +198,7 @@ class Untangler {
   /// crossings, then the fewest edges outside, then the first.
   bool try_moves(VertexHandle v, const std::vector<std::uint32_t>& near, std::size_t before) {
     const Vec3 start = mesh_.point(v);
-    Vec3 centroid(0, 0, 0);
-    int valence = 0;
-    for (auto w : mesh_.vv_range(v)) centroid += mesh_.point(w), ++valence;
-    if (valence == 0) return false;
-    centroid /= valence;
+    const Vec3 centroid = ring_centroid(mesh_, v);
     const Vec3 normal = geom::vertex_normal(mesh_, v);
     const std::size_t outside_before = outside_edges(v);
     Vec3 best = start;
@@ -309,10 +298,7 @@ class Untangler {
     for (int sweep = 0; sweep < kMembraneSweeps; ++sweep) {
       double largest = 0;
       for (auto v : disk.inner) {
-        Vec3 mean(0, 0, 0);
-        int n = 0;
-        for (auto w : mesh_.vv_range(v)) mean += mesh_.point(w), ++n;
-        mean /= n;
+        const Vec3 mean = ring_centroid(mesh_, v);
         largest = std::max(largest, (mean - mesh_.point(v)).sqrnorm());
         mesh_.point(v) = mean;
       }
@@ -360,12 +346,8 @@ class Untangler {
     // The faces outside the disk have not moved since index_faces(): their spheres are current.
     std::vector<std::uint32_t> near;
     for (auto f : disk.faces) {
-      OpenMesh::VertexHandle c[3];
-      geom::face_vertices(mesh_, f, c);
-      const Vec3 centre = (mesh_.point(c[0]) + mesh_.point(c[1]) + mesh_.point(c[2])) / 3.0;
-      double radius = 0;
-      for (auto v : c) radius = std::max(radius, (mesh_.point(v) - centre).norm());
-      face_index_->within(centre, (radius + spheres_.largest) * (1 + 1e-9), near);
+      const Sphere s = face_sphere(mesh_, f);
+      face_index_->within(s.centre, (s.radius + spheres_.largest) * (1 + 1e-9), near);
       for (std::uint32_t j : near) {
         const FaceHandle g = mesh_.face_handle(j);
         if (face_mark_[j] == disk_stamp_) continue;
