@@ -1,6 +1,7 @@
 #include "remesh/equalize.h"
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
@@ -127,6 +128,34 @@ void count_cleanup(IterationStats& row, const CleanupCounts& c) {
 /// edges the flattening left outside mended, 16 -> 5 edges outside in all.
 constexpr int kUntangleRounds = 3;
 
+/// A crossing face pair by its faces' corner positions, which stay put when edits elsewhere
+/// renumber the faces.
+using CrossingKey = std::array<double, 18>;
+std::vector<CrossingKey> crossing_keys(const TriMesh& mesh, const std::vector<std::pair<unsigned, unsigned>>& pairs) {
+  std::vector<CrossingKey> keys;
+  keys.reserve(pairs.size());
+  for (const auto& [f, g] : pairs) {
+    std::array<std::array<double, 9>, 2> faces;
+    for (int k = 0; k < 2; ++k) {
+      std::array<std::array<double, 3>, 3> corners;
+      int i = 0;
+      for (auto v : mesh.fv_range(mesh.face_handle(k == 0 ? f : g))) {
+        const Vec3& p = mesh.point(v);
+        corners[i++] = {p[0], p[1], p[2]};
+      }
+      std::sort(corners.begin(), corners.end());
+      for (int c = 0; c < 3; ++c) std::copy(corners[c].begin(), corners[c].end(), faces[k].begin() + 3 * c);
+    }
+    std::sort(faces.begin(), faces.end());
+    CrossingKey key;
+    std::copy(faces[0].begin(), faces[0].end(), key.begin());
+    std::copy(faces[1].begin(), faces[1].end(), key.begin() + 9);
+    keys.push_back(key);
+  }
+  std::sort(keys.begin(), keys.end());
+  return keys;
+}
+
 void untangle_and_mend(TriMesh& mesh, const ReferenceSurface& reference, const Params& params,
                        std::vector<NeighbourCache>& caches, IterationStats& row) {
   // The row describes the mesh before the feature snap, which takes no edge out of the interval.
@@ -135,6 +164,7 @@ void untangle_and_mend(TriMesh& mesh, const ReferenceSurface& reference, const P
     const UntangleCounts u = untangle(mesh, reference, params.e_min, params.e_max, params.threads);
     row.cleanup_fixes += u.moved;
     if (u.moved == 0 || round == kUntangleRounds) return;
+    const std::vector<CrossingKey> left = crossing_keys(mesh, find_self_intersections(mesh, params.threads));
     // Nothing to mend when no more edges are outside than before (the vertex moves never take
     // one out; a flattened disk may).
     const IterationStats now = measure(mesh, params.e_min, params.e_max, params.threads);
@@ -145,8 +175,11 @@ void untangle_and_mend(TriMesh& mesh, const ReferenceSurface& reference, const P
     options.caches = &caches;
     const CleanupCounts c = interval_cleanup(mesh, reference, params.e_min, params.e_max, params.flip_factor, options);
     count_cleanup(row, c);
-    // Again only if the cleanup made faces cross that did not before.
-    if (fixes(c) == 0 || find_self_intersections(mesh, params.threads).size() <= u.pairs_after) return;
+    // Again only if the cleanup made faces cross that did not before (the pairs it left alone
+    // keep their corners; its edits renumber the faces).
+    if (fixes(c) == 0) return;
+    const std::vector<CrossingKey> after = crossing_keys(mesh, find_self_intersections(mesh, params.threads));
+    if (std::includes(left.begin(), left.end(), after.begin(), after.end())) return;
   }
 }
 

@@ -108,22 +108,10 @@ class Untangler {
 
   /// One round of vertex moves over the vertices of `pairs`; returns the moves kept.
   std::size_t move_round(const Pairs& pairs) {
-    // Faces near a vertex: those whose centroid lies within the star's reach of it, from an index
-    // of the centroids at the start of the round, widened by the longest move the round may make.
-    const FaceSpheres spheres = face_spheres(mesh_);
-    const PointIndex index(spheres.centres);
-    double longest = 0;
-    for (auto e : mesh_.edges()) longest = std::max(longest, mesh_.calc_edge_length(e));
+    if (!face_index_) index_faces();
     std::size_t kept = 0;
-    std::vector<std::uint32_t> near;
-    for (auto v : vertices_of(mesh_, pairs)) {
-      if (mesh_.is_boundary(v)) continue;
-      // A face crossing the star has its centroid within the star's reach (longest), its own
-      // radius (largest) and what either moved this round (at most `longest` per move) of v.
-      index.within(mesh_.point(v), 3 * longest + spheres.largest, near);
-      const std::size_t before = crossings(v, near);
-      if (before > 0 && try_moves(v, near, before)) ++kept;
-    }
+    for (auto v : vertices_of(mesh_, pairs))
+      if (!mesh_.is_boundary(v) && try_moves(v)) ++kept;
     return kept;
   }
 
@@ -193,31 +181,55 @@ class Untangler {
     return n;
   }
 
+  /// The faces that may meet the ball of `radius` around p, from the index of index_faces(): a
+  /// face's centroid has moved by at most drift_ since, and its radius grown by at most 2 drift_.
+  void faces_near(const Vec3& p, double radius, std::vector<std::uint32_t>& out) const {
+    face_index_->within(p, (radius + spheres_.largest + 3 * drift_) * (1 + 1e-9), out);
+  }
+
   /// Of the candidate moves that fold nothing (geom::move_is_safe), leave no more of v's edges
   /// outside the interval and lower the crossings of v's faces, keeps the one with the fewest
-  /// crossings, then the fewest edges outside, then the first.
-  bool try_moves(VertexHandle v, const std::vector<std::uint32_t>& near, std::size_t before) {
+  /// crossings, then the fewest edges outside, then the first. The star of v, before or after a
+  /// move to p, lies in the ball around v's position whose radius is the larger of its longest edge
+  /// and |p - v| (a ball is convex), so the faces that can cross it are those faces_near() finds.
+  bool try_moves(VertexHandle v) {
     const Vec3 start = mesh_.point(v);
+    double reach = 0;
+    for (auto w : mesh_.vv_range(v)) reach = std::max(reach, (mesh_.point(w) - start).norm());
+    std::vector<std::uint32_t>& near = near_;
+    faces_near(start, reach, near);
+    const std::size_t before = crossings(v, near);
+    if (before == 0) return false;
     const Vec3 centroid = ring_centroid(mesh_, v);
     const Vec3 normal = geom::vertex_normal(mesh_, v);
+    // On the reference first (the surface stays the input's), else where the ring puts it.
+    std::vector<Vec3> candidates;
+    double radius = reach;
+    for (double s : kSteps) {
+      const Vec3 target = start + s * (centroid - start);
+      for (const Vec3& p : {project_vertex(mesh_, v, target, normal, reference_), target}) {
+        candidates.push_back(p);
+        radius = std::max(radius, (p - start).norm());
+      }
+    }
+    if (radius > reach) faces_near(start, radius, near);
     const std::size_t outside_before = outside_edges(v);
     Vec3 best = start;
     std::pair<std::size_t, std::size_t> best_score{before, outside_before};
-    for (double s : kSteps) {
-      const Vec3 target = start + s * (centroid - start);
-      // On the reference first (the surface stays the input's), else where the ring puts it.
-      for (const Vec3& p : {project_vertex(mesh_, v, target, normal, reference_), target}) {
-        if (p == start || !geom::move_is_safe(mesh_, v, p)) continue;
-        mesh_.point(v) = p;
-        const std::size_t out = outside_edges(v);
-        const std::pair<std::size_t, std::size_t> score{out <= outside_before ? crossings(v, near) : before, out};
-        mesh_.point(v) = start;
-        if (score.first < before && score < best_score) best = p, best_score = score;
-      }
+    for (const Vec3& p : candidates) {
+      if (p == start || !geom::move_is_safe(mesh_, v, p)) continue;
+      mesh_.point(v) = p;
+      const std::size_t out = outside_edges(v);
+      const std::pair<std::size_t, std::size_t> score{out <= outside_before ? crossings(v, near) : before, out};
+      mesh_.point(v) = start;
+      if (score.first < before && score < best_score) best = p, best_score = score;
     }
     if (best == start) return false;
     mesh_.point(v) = best;
     note_move(start, best);
+    // How far v now is from where index_faces() saw it.
+    const Vec3 indexed = origins_.emplace(v.idx(), start).first->second;
+    drift_ = std::max(drift_, (best - indexed).norm());
     return true;
   }
 
@@ -370,6 +382,8 @@ class Untangler {
   void index_faces() {
     spheres_ = face_spheres(mesh_);
     face_index_.emplace(spheres_.centres);
+    origins_.clear();
+    drift_ = 0;
   }
 
   TriMesh& mesh_;
@@ -377,6 +391,10 @@ class Untangler {
   FaceSpheres spheres_;
   std::optional<PointIndex> face_index_;
   mutable std::vector<FaceSphere> star_;  ///< crossings()' scratch
+  std::vector<std::uint32_t> near_;       ///< try_moves()' scratch
+  /// The position at index_faces() of each vertex moved since, and the farthest any has moved.
+  std::unordered_map<int, Vec3> origins_;
+  double drift_ = 0;
   double e_min_, e_max_;
   std::vector<int> vertex_mark_, face_mark_;
   Box moves_;
