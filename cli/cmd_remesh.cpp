@@ -108,6 +108,10 @@ void print_final(const TriMesh& mesh, const Job& job, const Result& result) {
   std::printf("result: %zu vertices, %zu edges, %zu faces\n", s.vertices, s.edges, s.faces);
   std::printf("  edges inside [%g, %g]: %.3f %% (%zu small, %zu big)\n", job.params.e_min, job.params.e_max,
               100.0 * q.inside_fraction, q.small, q.big);
+  if (result.thin.outside > 0)
+    std::printf("  in thin parts:        %zu of the %zu edges outside (the input is thinner than %g = 2 e_min / "
+                "sqrt(3) there: too thin for edges in the interval)\n",
+                result.thin.in_thin_parts, result.thin.outside, result.thin.limit);
   std::printf("  regular vertices:     %.2f %%\n", q.regular_percent);
   std::printf("  edge length:          mean %.6g, deviation %.4g, min %.6g, max %.6g\n", q.mean, q.deviation,
               s.min_edge, s.max_edge);

@@ -421,6 +421,7 @@ Result equalize(TriMesh& mesh, const Params& params, const OnIteration& on_itera
     }
   }
   flush();
+  result.thin = thin_parts(mesh, *reference, params.e_min, params.e_max, threads);
   result.seconds = seconds_since(start);
   return result;
 }

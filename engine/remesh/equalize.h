@@ -17,6 +17,7 @@
 
 #include "core/mesh.h"
 #include "remesh/params.h"
+#include "remesh/thin_parts.h"
 
 namespace remesh {
 
@@ -53,6 +54,9 @@ struct Result {
   Outcome outcome = Outcome::Completed;
   int iterations_done = 0;
   double seconds = 0;
+  /// The returned mesh's edges outside the interval, and how many of them lie where the input is
+  /// too thin for any edge there to be inside (thin_parts.h).
+  ThinParts thin;
 };
 
 /// Estimated face count of the output: area / (sqrt(3)/4 * m^2), m = (e_min + e_max) / 2.

@@ -33,6 +33,7 @@ struct ReferenceSurface::Impl {
   Csr vertex_triangles;             ///< triangles incident to each vertex
   /// per vertex: its longest incident edge, so every incident triangle lies within this distance
   std::vector<double> vertex_reach;
+  double largest_reach = 0;  ///< the largest vertex_reach
   /// per triangle: the triangle across its edge (corner k, corner k+1), or kNone (boundary edge)
   std::vector<std::array<std::uint32_t, 3>> across;
   static constexpr std::uint32_t kNone = UINT32_MAX;
@@ -149,6 +150,7 @@ ReferenceSurface::ReferenceSurface(const TriMesh& mesh, std::size_t neighbours)
       const double l = (m.points[a] - m.points[b]).norm();
       m.vertex_reach[a] = std::max(m.vertex_reach[a], l);
       m.vertex_reach[b] = std::max(m.vertex_reach[b], l);
+      m.largest_reach = std::max(m.largest_reach, l);
     }
   for (std::size_t v = 0; v < nv; ++v) m.vertex_triangles.offsets[v + 1] += m.vertex_triangles.offsets[v];
   m.vertex_triangles.items.resize(m.vertex_triangles.offsets[nv]);
@@ -208,6 +210,32 @@ ReferenceSurface& ReferenceSurface::operator=(ReferenceSurface&&) noexcept = def
 std::size_t ReferenceSurface::n_vertices() const { return impl_->points.size(); }
 std::size_t ReferenceSurface::n_triangles() const { return impl_->triangles.size(); }
 bool ReferenceSurface::has_boundary() const { return impl_->boundary_edges > 0; }
+
+double ReferenceSurface::opposite_side_distance(const Vec3& p, const Vec3& normal, double limit) const {
+  const Impl& m = *impl_;
+  constexpr double kOpposite = -0.3;
+  if (!(limit > 0)) return std::numeric_limits<double>::infinity();
+  double best2 = limit * limit;
+  // A triangle nearer than `limit` has a corner v within limit + vertex_reach[v] of p.
+  std::vector<std::pair<std::uint32_t, double>> found;
+  const double q[3] = {p[0], p[1], p[2]};
+  const double radius = limit + m.largest_reach;
+  m.tree->radiusSearch(q, radius * radius, found, nanoflann::SearchParams(32, 0.0f, false));
+  bool any = false;
+  for (const auto& [v, d2] : found) {
+    const double reach = limit + m.vertex_reach[v];
+    if (d2 > reach * reach) continue;
+    for (std::uint32_t j = m.vertex_triangles.offsets[v]; j < m.vertex_triangles.offsets[v + 1]; ++j) {
+      const std::uint32_t t = m.vertex_triangles.items[j];
+      if ((m.unit_normals[t] | normal) >= kOpposite) continue;
+      const auto& tri = m.triangles[t];
+      const Vec3 c = geom::closest_point_on_triangle(p, m.points[tri[0]], m.points[tri[1]], m.points[tri[2]]);
+      const double c2 = (c - p).sqrnorm();
+      if (c2 < best2) best2 = c2, any = true;
+    }
+  }
+  return any ? std::sqrt(best2) : std::numeric_limits<double>::infinity();
+}
 
 std::size_t ReferenceSurface::nearest_vertices(const Vec3& p, std::size_t k, std::uint32_t* out) const {
   return impl_->nearest(p, out, k);

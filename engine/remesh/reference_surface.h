@@ -56,6 +56,11 @@ class ReferenceSurface {
   /// that mesh had no deleted vertices.
   std::size_t nearest_vertices(const Vec3& p, std::size_t k, std::uint32_t* out) const;
 
+  /// Distance from p to the nearest reference triangle that faces against `normal` (a unit vector;
+  /// the triangle's unit normal n with n . normal < -0.3): the other side of the part p lies on.
+  /// Only triangles nearer than `limit` are looked at; infinity when there is none.
+  double opposite_side_distance(const Vec3& p, const Vec3& normal, double limit) const;
+
   /// True when the reference has at least one boundary edge.
   bool has_boundary() const;
 

@@ -289,6 +289,31 @@ TEST_CASE("a short remesh run writes the mesh, the dual and one stats row per it
   CHECK(stats.back().contains("max_projection_distance"));
 }
 
+TEST_CASE("the summary says how many edges outside lie in parts too thin for the interval", "[cli]") {
+  TempDir dir;
+  // A torus whose tube is 0.5 across: no ring of edges of at least 1.2 follows it.
+  write_obj(remesh::test::make_torus(48, 8, 4.0, 0.25), dir.file("thin.obj"));
+  const ProcessResult r = remesh_cli({dir.file("thin.obj"), dir.file("out.obj"), "--emin", "1.2", "--emax", "1.8",
+                                      "--iterations", "10"});
+  INFO(r.out << r.err);
+  REQUIRE(r.exit_code == 0);
+  const auto at = r.out.find("in thin parts:");
+  REQUIRE(at != std::string::npos);
+  // "N of the N edges outside": every edge outside lies on the thin tube.
+  std::istringstream line(r.out.substr(at + std::string("in thin parts:").size()));
+  std::size_t thin = 0, outside = 0;
+  std::string of, the;
+  line >> thin >> of >> the >> outside;
+  CHECK(thin > 0);
+  CHECK(thin == outside);
+  // A sphere whose edges all fit has no such line.
+  write_obj(remesh::test::make_icosphere(3, 4.0), dir.file("sphere.obj"));
+  const ProcessResult s = remesh_cli({dir.file("sphere.obj"), dir.file("out2.obj"), "--emin", "1.2", "--emax", "1.8"});
+  REQUIRE(s.exit_code == 0);
+  CHECK(s.out.find("100.000 %") != std::string::npos);
+  CHECK(s.out.find("in thin parts") == std::string::npos);
+}
+
 TEST_CASE("a job over --max-faces is refused with exit 3", "[cli]") {
   TempDir dir;
   write_obj(remesh::test::make_icosphere(2), dir.file("sphere.obj"));

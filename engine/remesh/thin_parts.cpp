@@ -1,0 +1,40 @@
+#include "remesh/thin_parts.h"
+
+#include <atomic>
+#include <cmath>
+#include <vector>
+
+#include "core/parallel.h"
+#include "remesh/geometry.h"
+
+namespace remesh {
+
+ThinParts thin_parts(const TriMesh& mesh, const ReferenceSurface& reference, double e_min, double e_max,
+                     unsigned threads) {
+  ThinParts out;
+  out.limit = 2.0 * e_min / std::sqrt(3.0);
+  std::vector<OpenMesh::EdgeHandle> outside;
+  for (auto e : mesh.edges()) {
+    if (mesh.status(e).deleted()) continue;
+    const double l = mesh.calc_edge_length(e);
+    if (l < e_min || l > e_max) outside.push_back(e);
+  }
+  out.outside = outside.size();
+  std::atomic<std::size_t> thin{0};
+  parallel_for(outside.size(), threads, [&](std::size_t i) {
+    const auto h = mesh.halfedge_handle(outside[i], 0);
+    Vec3 normal(0, 0, 0);
+    for (auto g : {h, mesh.opposite_halfedge_handle(h)})
+      if (!mesh.is_boundary(g)) {
+        const Vec3 n = geom::face_normal(mesh, mesh.face_handle(g));
+        if (const double l = n.norm(); l > 0) normal += n / l;
+      }
+    if (!(normal.norm() > 0)) return;
+    const Vec3 mid = 0.5 * (mesh.point(mesh.from_vertex_handle(h)) + mesh.point(mesh.to_vertex_handle(h)));
+    if (reference.opposite_side_distance(mid, normal.normalized(), out.limit) < out.limit) ++thin;
+  }, 64);
+  out.in_thin_parts = thin;
+  return out;
+}
+
+}  // namespace remesh

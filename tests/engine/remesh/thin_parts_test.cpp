@@ -1,0 +1,100 @@
+// Why edges are left outside the interval: the thickness of the reference at them (thin_parts.h).
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <limits>
+#include <random>
+#include <vector>
+
+#include "remesh/equalize.h"
+#include "remesh/geometry.h"
+#include "remesh/reference_surface.h"
+#include "remesh/thin_parts.h"
+#include "support/mesh_generators.h"
+
+using namespace remesh;
+
+namespace {
+
+/// opposite_side_distance by testing every triangle.
+double brute_opposite(const TriMesh& m, const Vec3& p, const Vec3& normal, double limit) {
+  double best = std::numeric_limits<double>::infinity();
+  for (auto f : m.faces()) {
+    const Vec3 n = geom::face_normal(m, f);
+    if (!(n.norm() > 0) || ((n / n.norm()) | normal) >= -0.3) continue;
+    Vec3 c[3];
+    int k = 0;
+    for (auto v : m.fv_range(f)) c[k++] = m.point(v);
+    const double d = (geom::closest_point_on_triangle(p, c[0], c[1], c[2]) - p).norm();
+    if (d < limit) best = std::min(best, d);
+  }
+  return best;
+}
+
+}  // namespace
+
+TEST_CASE("opposite_side_distance is the nearest triangle facing the other way within the limit", "[thin]") {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> limit_of(0.05, 4.0), jitter(-0.2, 0.2);
+  for (const TriMesh& m : {test::make_torus(40, 10, 3.0, 0.4), test::make_torus(48, 24, 5.0, 2.0),
+                           test::make_double_torus(1.0, 2), test::make_icosphere(3, 2.0)}) {
+    const ReferenceSurface reference(m);
+    const std::vector<Vec3> normals = geom::vertex_normals(m, 1);
+    std::size_t finite = 0;
+    for (int i = 0; i < 300; ++i) {
+      const auto v = m.vertex_handle(static_cast<unsigned>(rng() % m.n_vertices()));
+      const Vec3 p = m.point(v) + Vec3(jitter(rng), jitter(rng), jitter(rng));
+      const Vec3 n = normals[v.idx()].normalized();
+      const double limit = limit_of(rng);
+      const double got = reference.opposite_side_distance(p, n, limit);
+      const double want = brute_opposite(m, p, n, limit);
+      if (std::isinf(want)) {
+        CHECK(std::isinf(got));
+      } else {
+        ++finite;
+        CHECK(got == Approx(want).margin(1e-12));
+      }
+    }
+    // Both answers occur on the tori: the tube's other side within some limits, not others.
+    if (m.n_vertices() == 400) CHECK(finite > 0);
+  }
+}
+
+TEST_CASE("thin_parts counts the edges outside where the reference is thinner than 2 e_min / sqrt(3)", "[thin]") {
+  // The thin torus has every edge shorter than 1.2, the thick one most. The thin one's tube is 0.6
+  // across (< 1.39); the thick one's is 6 across and its hole 10.
+  const TriMesh thin = test::make_torus(40, 10, 3.0, 0.3), thick = test::make_torus(64, 32, 8.0, 3.0);
+  const ThinParts a = thin_parts(thin, ReferenceSurface(thin), 1.2, 1.8, 2);
+  CHECK(a.outside == thin.n_edges());
+  CHECK(a.in_thin_parts == a.outside);
+  CHECK(a.limit == Approx(2.4 / std::sqrt(3.0)));
+  const ThinParts b = thin_parts(thick, ReferenceSurface(thick), 1.2, 1.8, 2);
+  const IterationStats s = measure(thick, 1.2, 1.8, 1);
+  CHECK(b.outside == s.small + s.big);
+  CHECK(b.outside > thick.n_edges() / 2);
+  CHECK(b.in_thin_parts == 0);
+  // With an interval the thick torus's edges fit, nothing is outside.
+  const ThinParts c = thin_parts(thick, ReferenceSurface(thick), 0.3, 1.5, 1);
+  CHECK(c.outside == 0);
+  CHECK(c.in_thin_parts == 0);
+}
+
+TEST_CASE("equalize reports the returned mesh's edges outside and those in thin parts", "[thin]") {
+  // A torus whose tube (0.5 across) no ring of edges of at least 1.2 can follow, and a sphere.
+  for (const bool thin : {true, false}) {
+    TriMesh m = thin ? test::make_torus(48, 8, 4.0, 0.25) : test::make_icosphere(3, 4.0);
+    Params p;
+    p.e_min = 1.2;
+    p.e_max = 1.8;
+    p.iterations = 20;
+    const Result r = equalize(m, p);
+    const IterationStats s = measure(m, p.e_min, p.e_max, 1);
+    CHECK(r.thin.outside == s.small + s.big);
+    if (thin) {
+      CHECK(r.thin.outside > 0);
+      CHECK(r.thin.in_thin_parts == r.thin.outside);
+    } else {
+      CHECK(r.thin.in_thin_parts == 0);
+    }
+  }
+}
