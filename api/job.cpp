@@ -120,6 +120,10 @@ json job_to_json(const JobRecord& job, std::string_view prefix, double now) {
       {"progress", {{"iteration", job.iteration}, {"iterations", job.params.iterations}}},
       {"latest", job.latest ? json(*job.latest) : json(nullptr)},
       {"outcome", job.outcome ? json(*job.outcome) : json(nullptr)},
+      {"thin_parts", job.thin_parts ? json{{"outside", job.thin_parts->outside},
+                                           {"in_thin_parts", job.thin_parts->in_thin_parts},
+                                           {"limit", job.thin_parts->limit}}
+                                     : json(nullptr)},
       {"error", job.error ? json(*job.error) : json(nullptr)},
       {"timings",
        {{"queued_seconds", std::max(0.0, queued_end - job.created_at)},
@@ -152,6 +156,10 @@ JobRecord job_from_json(const json& j) {
     job.iteration = j.at("progress").at("iteration").get<int>();
     if (!j.at("latest").is_null()) job.latest = j.at("latest").get<IterationStats>();
     if (!j.at("outcome").is_null()) job.outcome = j.at("outcome").get<std::string>();
+    // Absent in documents written before the field existed.
+    if (const auto t = j.find("thin_parts"); t != j.end() && !t->is_null())
+      job.thin_parts = ThinParts{t->at("outside").get<std::size_t>(), t->at("in_thin_parts").get<std::size_t>(),
+                                 t->at("limit").get<double>()};
     if (!j.at("error").is_null()) job.error = j.at("error").get<std::string>();
     return job;
   } catch (const json::exception& e) {

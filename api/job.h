@@ -46,6 +46,9 @@ struct JobRecord {
   int iteration = 0;           ///< iterations done
   std::optional<IterationStats> latest;
   std::optional<std::string> outcome;  ///< "converged", "completed", "cancelled"
+  /// Of the result: its edges outside the interval and those in parts of the input too thin for
+  /// any edge there to be inside (remesh/thin_parts.h); nullopt until the job succeeded.
+  std::optional<ThinParts> thin_parts;
   std::optional<std::string> error;
 };
 

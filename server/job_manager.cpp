@@ -215,6 +215,7 @@ void JobManager::run(const std::string& id) {
     {
       std::lock_guard lock(mutex_);
       job->record.outcome = std::string(remesh::api::outcome_name(out.outcome));
+      job->record.thin_parts = out.thin;
       job->interrupted = false;  // it finished anyway
     }
     finish(JobState::Succeeded);

@@ -36,6 +36,7 @@ RunOutput run_job(const remesh::api::JobRecord& job, std::string_view upload, un
   RunOutput out;
   out.outcome = result.outcome;
   out.iterations_done = result.iterations_done;
+  out.thin = result.thin;
   if (result.outcome == remesh::Outcome::Cancelled) return out;
 
   mesh.garbage_collection();

@@ -16,6 +16,7 @@ namespace remeshd {
 struct RunOutput {
   remesh::Outcome outcome = remesh::Outcome::Completed;
   int iterations_done = 0;
+  remesh::ThinParts thin;  ///< Result::thin
   /// File name ("remeshed.obj", "dual.glb", ...) -> bytes; empty when cancelled.
   std::map<std::string, std::string> files;
 };

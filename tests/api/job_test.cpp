@@ -52,6 +52,7 @@ TEST_CASE("job document: fields, links only when succeeded, round trip", "[api][
   CHECK(doc["started_at"].is_null());
   CHECK(doc["latest"].is_null());
   CHECK(doc["outcome"].is_null());
+  CHECK(doc["thin_parts"].is_null());
   CHECK(doc["error"].is_null());
   CHECK(doc["params"]["emin"] == 0.5);
   CHECK(doc["params"]["weld"] == false);
@@ -70,7 +71,11 @@ TEST_CASE("job document: fields, links only when succeeded, round trip", "[api][
   last.mean = 0.75;
   r.latest = last;
   r.iteration = 9;
+  r.thin_parts = ThinParts{12, 7, 1.25};
   doc = job_to_json(r, "/api/v1", r.created_at + 100);
+  CHECK(doc["thin_parts"]["outside"] == 12);
+  CHECK(doc["thin_parts"]["in_thin_parts"] == 7);
+  CHECK(doc["thin_parts"]["limit"] == 1.25);
   CHECK(doc["timings"]["queued_seconds"] == Approx(1.0));
   CHECK(doc["timings"]["run_seconds"] == Approx(3.0));
   REQUIRE(doc["links"].contains("results"));
@@ -85,6 +90,14 @@ TEST_CASE("job document: fields, links only when succeeded, round trip", "[api][
   CHECK(back.params.e_max == 1.0);
   CHECK(back.latest->mean == 0.75);
   CHECK(back.outcome == std::optional<std::string>("converged"));
+  REQUIRE(back.thin_parts);
+  CHECK(back.thin_parts->outside == 12);
+  CHECK(back.thin_parts->in_thin_parts == 7);
+  CHECK(back.thin_parts->limit == 1.25);
+  // A document written before the field existed still reads.
+  json old = doc;
+  old.erase("thin_parts");
+  CHECK_FALSE(job_from_json(old).thin_parts);
 
   json broken = doc;
   broken["state"] = "sleeping";

@@ -1,6 +1,7 @@
 // Every route and every error status of the public API, against the real daemon.
 #include <catch2/catch.hpp>
 
+#include <cmath>
 #include <fstream>
 #include <regex>
 #include <set>
@@ -88,6 +89,10 @@ TEST_CASE("remeshd: submit raw and multipart, follow, download, list, delete", "
   CHECK(done["latest"]["iteration"] == done["progress"]["iteration"]);
   CHECK(done["finished_at"].is_string());
   CHECK(done["timings"]["run_seconds"].get<double>() >= 0);
+  // The edges outside, as the last row counts them; none can be in a thin part of a ball.
+  CHECK(done["thin_parts"]["outside"] == done["latest"]["small"].get<int>() + done["latest"]["big"].get<int>());
+  CHECK(done["thin_parts"]["in_thin_parts"] == 0);
+  CHECK(done["thin_parts"]["limit"].get<double>() == Approx(0.4 / std::sqrt(3.0)));
   REQUIRE(done["links"].contains("results"));
   for (const auto& [kind, formats] : done["links"]["results"].items())
     for (const auto& [fmt, url] : formats.items()) {
