@@ -128,28 +128,21 @@ void count_cleanup(IterationStats& row, const CleanupCounts& c) {
 /// edges the flattening left outside mended, 16 -> 5 edges outside in all.
 constexpr int kUntangleRounds = 3;
 
-/// A crossing face pair by its faces' corner positions, which stay put when edits elsewhere
+/// A crossing face pair by its six corners' positions, sorted: they stay put when edits elsewhere
 /// renumber the faces.
-using CrossingKey = std::array<double, 18>;
+using CrossingKey = std::array<std::array<double, 3>, 6>;
 std::vector<CrossingKey> crossing_keys(const TriMesh& mesh, const std::vector<std::pair<unsigned, unsigned>>& pairs) {
   std::vector<CrossingKey> keys;
   keys.reserve(pairs.size());
   for (const auto& [f, g] : pairs) {
-    std::array<std::array<double, 9>, 2> faces;
-    for (int k = 0; k < 2; ++k) {
-      std::array<std::array<double, 3>, 3> corners;
-      int i = 0;
-      for (auto v : mesh.fv_range(mesh.face_handle(k == 0 ? f : g))) {
-        const Vec3& p = mesh.point(v);
-        corners[i++] = {p[0], p[1], p[2]};
-      }
-      std::sort(corners.begin(), corners.end());
-      for (int c = 0; c < 3; ++c) std::copy(corners[c].begin(), corners[c].end(), faces[k].begin() + 3 * c);
-    }
-    std::sort(faces.begin(), faces.end());
     CrossingKey key;
-    std::copy(faces[0].begin(), faces[0].end(), key.begin());
-    std::copy(faces[1].begin(), faces[1].end(), key.begin() + 9);
+    int i = 0;
+    for (unsigned face : {f, g})
+      for (auto v : mesh.fv_range(mesh.face_handle(face))) {
+        const Vec3& p = mesh.point(v);
+        key[i++] = {p[0], p[1], p[2]};
+      }
+    std::sort(key.begin(), key.end());
     keys.push_back(key);
   }
   std::sort(keys.begin(), keys.end());
@@ -164,11 +157,11 @@ void untangle_and_mend(TriMesh& mesh, const ReferenceSurface& reference, const P
     const UntangleCounts u = untangle(mesh, reference, params.e_min, params.e_max, params.threads);
     row.cleanup_fixes += u.moved;
     if (u.moved == 0 || round == kUntangleRounds) return;
-    const std::vector<CrossingKey> left = crossing_keys(mesh, find_self_intersections(mesh, params.threads));
     // Nothing to mend when no more edges are outside than before (the vertex moves never take
     // one out; a flattened disk may).
     const IterationStats now = measure(mesh, params.e_min, params.e_max, params.threads);
     if (now.small + now.big <= outside_before) return;
+    const std::vector<CrossingKey> left = crossing_keys(mesh, u.left);
     CleanupOptions options;
     options.rounds = kFinalCleanupRounds;
     options.patch_budget = final_patch_budget(mesh);

@@ -430,7 +430,7 @@ UntangleCounts untangle(TriMesh& mesh, const ReferenceSurface& reference, double
       move_rounds();
     }
   }
-  counts.pairs_after = pairs.size();
+  counts.left = std::move(pairs);
   return counts;
 }
 

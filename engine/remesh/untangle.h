@@ -15,6 +15,8 @@
 /// input and CGAL's output have none.
 
 #include <cstddef>
+#include <utility>
+#include <vector>
 
 #include "core/mesh.h"
 #include "remesh/reference_surface.h"
@@ -22,9 +24,11 @@
 namespace remesh {
 
 struct UntangleCounts {
-  std::size_t pairs_before = 0, pairs_after = 0;  ///< crossing face pairs
-  std::size_t moved = 0;                          ///< vertex moves and flattened vertices
-  std::size_t flattened = 0;                      ///< of them, vertices of flattened disks
+  std::size_t pairs_before = 0;  ///< crossing face pairs before
+  /// The crossing face pairs left, as find_self_intersections() would give them now.
+  std::vector<std::pair<unsigned, unsigned>> left;
+  std::size_t moved = 0;      ///< vertex moves and flattened vertices
+  std::size_t flattened = 0;  ///< of them, vertices of flattened disks
 };
 
 /// Moves the vertices of crossing faces of `mesh` apart (see the file comment). The mesh stays
