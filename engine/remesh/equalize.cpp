@@ -225,7 +225,7 @@ Result equalize(TriMesh& mesh, const Params& params, const OnIteration& on_itera
   const double sigma = 0.5 * (params.e_max - params.e_min);
   mesh.garbage_collection();
   auto reference = std::make_unique<ReferenceSurface>(mesh);
-  auto features = std::make_unique<FeatureSnap>(mesh);
+  auto features = std::make_unique<FeatureSnap>(mesh, params.e_min);
   std::vector<NeighbourCache> neighbour_caches;  // per vertex, for the projection (projection.h)
 
   Result result;
@@ -256,7 +256,7 @@ Result equalize(TriMesh& mesh, const Params& params, const OnIteration& on_itera
     IterationStats counters;
     if (params.relax_every > 0 && i % params.relax_every == 0) {
       reference = std::make_unique<ReferenceSurface>(mesh);
-      features = std::make_unique<FeatureSnap>(mesh);
+      features = std::make_unique<FeatureSnap>(mesh, params.e_min);
     }
 
     // Algorithms 2 and 3: stellar operations on the priority list.

@@ -6,12 +6,18 @@
 /// remeshed surface cuts the tip: the largest distance from the input to the output (one half of
 /// the Hausdorff distance) lies at such a reference vertex.
 ///
+/// The same holds along a crease of the reference between its vertices: where two faces meet at
+/// more than 20 degrees, a mesh edge that crosses the crease between vertices on either face cuts
+/// under it (eight.off, a coarse input whose waist creases meet at 38 degrees: 0.26 units, the
+/// largest distance of the run). So the points are the interior reference vertices and, when the
+/// run gives a spacing (equalize: e_min), points along every such crease at most that far apart.
+///
 /// In the last iteration of a run (converged, stalled or n reached), up to kSnapPasses passes:
-/// every interior reference vertex farther from the mesh than a tenth of e_min and at least
+/// every such point farther from the mesh than a tenth of e_min and at least
 /// kFarShare of the farthest one's distance takes its nearest mesh vertex (farthest first), which
 /// moves onto it while the 2-ring around it relaxes (snap_to_features in interval_cleanup.h). A
 /// move is kept only if it folds nothing, leaves no more edges of the patch outside
-/// [e_min, e_max], brings the point nearer, and pulls no other reference vertex near the patch
+/// [e_min, e_max], brings the point nearer, and pulls no other of the points near the patch
 /// farther from it than that vertex or the point was (GapJudge in interval_cleanup.cpp). For the
 /// points from kPartialShare of the farthest distance, a refused move is retried over 85, 70, 55,
 /// 40, 25, 15 and 8 % of the way (a horn too thin for a vertex at its apex with edges in the
@@ -22,7 +28,10 @@
 /// A pass after the first measures again only the points near a vertex the last pass moved.
 /// Measured (Table 4.2 setup, Hausdorff in % of the bbox diagonal, exact distances; before ->
 /// after, CGAL's in brackets): spot 0.65 -> 0.44 (0.63), bunny 0.77 -> 0.67 (0.69),
-/// kitten 0.39 -> 0.33 (0.40), fandisk 0.645 -> 0.52 (0.65).
+/// kitten 0.39 -> 0.33 (0.40), fandisk 0.645 -> 0.52 (0.65). With the crease points: eight
+/// 0.46 -> 0.43 (0.33), mountain 0.169 -> 0.139 (0.190), bunny_zipper 0.205 -> 0.174 (0.265),
+/// nefertiti 0.185 -> 0.175 (0.193), but bunny 0.64 -> 0.68 (0.69): another snap order, another
+/// local optimum; about 3 % more time on nefertiti and mountain.
 
 #include <cstddef>
 #include <vector>
@@ -35,8 +44,9 @@ namespace remesh {
 
 class FeatureSnap {
  public:
-  /// Collects the interior vertices of `reference` (a valid mesh, typically the input).
-  explicit FeatureSnap(const TriMesh& reference);
+  /// Collects the interior vertices of `reference` (a valid mesh, typically the input) and, when
+  /// `crease_spacing` > 0, points along its creases at most that far apart (see the file comment).
+  explicit FeatureSnap(const TriMesh& reference, double crease_spacing = 0);
 
   /// The snap of a run's last iteration: up to kSnapPasses passes within the budget. Precondition:
   /// `mesh` has no deleted elements. Returns the number of moves kept. Deterministic (the order is
