@@ -40,16 +40,17 @@ std::vector<Vec3> feature_points(const TriMesh& reference, double crease_spacing
     if (!reference.status(v).deleted() && !reference.is_isolated(v) && !reference.is_boundary(v))
       points.push_back(reference.point(v));
   if (!(crease_spacing > 0)) return points;
+  const std::vector<Vec3> normals = geom::face_normals(reference, 1);  // each face's once, not per edge
   for (auto e : reference.edges()) {
     if (reference.status(e).deleted() || reference.is_boundary(e)) continue;
     const auto h = reference.halfedge_handle(e, 0);
     const Vec3 a = reference.point(reference.from_vertex_handle(h)), b = reference.point(reference.to_vertex_handle(h));
     const double length = (b - a).norm();
     if (length <= crease_spacing) continue;
-    const Vec3 n0 = geom::face_normal(reference, reference.face_handle(h));
-    const Vec3 n1 = geom::face_normal(reference, reference.opposite_face_handle(h));
-    const double l0 = n0.norm(), l1 = n1.norm();
-    if (!(l0 > 0 && l1 > 0) || (n0 | n1) >= kCreaseCos * l0 * l1) continue;
+    const Vec3& n0 = normals[reference.face_handle(h).idx()];
+    const Vec3& n1 = normals[reference.opposite_face_handle(h).idx()];
+    // A degenerate face has no direction to disagree with.
+    if (n0.sqrnorm() == 0 || n1.sqrnorm() == 0 || geom::normals_agree(n0, n1, kCreaseCos)) continue;
     const int parts = static_cast<int>(std::ceil(length / crease_spacing));
     for (int k = 1; k < parts; ++k) points.push_back(a + (static_cast<double>(k) / parts) * (b - a));
   }
