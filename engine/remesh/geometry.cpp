@@ -72,12 +72,13 @@ bool normals_agree(const Vec3& before, const Vec3& after, double min_cos) {
   return (before | after) > min_cos * nb * na;
 }
 
-bool adjacent_ok(const Vec3& f_before, const Vec3& g_before, const Vec3& f_after, const Vec3& g_after) {
+bool adjacent_ok(const Vec3& f_before, const Vec3& g_before, const Vec3& f_after, const Vec3& g_after,
+                 double min_cos) {
   const double na = f_after.norm() * g_after.norm();
   if (!(na > 0)) return false;
-  if ((f_after | g_after) >= 0) return true;  // cos_after >= 0 > kMinAdjacentCos
+  if ((f_after | g_after) >= 0) return true;  // cos_after >= 0 >= min_cos
   const double cos_after = (f_after | g_after) / na;
-  if (cos_after >= kMinAdjacentCos) return true;
+  if (cos_after >= min_cos) return true;
   const double nb = f_before.norm() * g_before.norm();
   return nb > 0 && cos_after >= (f_before | g_before) / nb;
 }
@@ -160,7 +161,7 @@ double angle_deficit(const TriMesh& mesh, OpenMesh::VertexHandle v) {
   return 2 * M_PI - angles;
 }
 
-bool move_is_safe(const TriMesh& mesh, OpenMesh::VertexHandle v, const Vec3& p) {
+bool move_is_safe(const TriMesh& mesh, OpenMesh::VertexHandle v, const Vec3& p, double min_adjacent_cos) {
   AngleFloor floor([&] { return star_min_angle(mesh, v); });
   // No fold between a face of the star and any of its neighbours.
   for (auto h : mesh.voh_range(v)) {
@@ -169,7 +170,7 @@ bool move_is_safe(const TriMesh& mesh, OpenMesh::VertexHandle v, const Vec3& p) 
     for (auto g : {mesh.opposite_face_handle(h), mesh.opposite_face_handle(mesh.next_halfedge_handle(h))}) {
       if (!g.is_valid()) continue;
       if (!adjacent_ok(face_normal(mesh, f), face_normal(mesh, g), moved_normal(mesh, f, v, p),
-                       moved_normal(mesh, g, v, p)))
+                       moved_normal(mesh, g, v, p), min_adjacent_cos))
         return false;
     }
   }

@@ -61,8 +61,11 @@ constexpr double kMinNormalCos = 0.5;
 constexpr double kMinAdjacentCos = -0.5;
 static_assert(kMinAdjacentCos <= 0, "adjacent_ok() accepts a pair with a non-negative cosine at once");
 
-/// Is the pair of adjacent faces (unnormalised normals, before and after an edit) acceptable?
-bool adjacent_ok(const Vec3& f_before, const Vec3& g_before, const Vec3& f_after, const Vec3& g_after);
+/// Is the pair of adjacent faces (unnormalised normals, before and after an edit) acceptable? With
+/// `min_cos` (at most 0) in place of kMinAdjacentCos: the feature snap's looser limit
+/// (interval_cleanup.cpp, kSnapAdjacentCos).
+bool adjacent_ok(const Vec3& f_before, const Vec3& g_before, const Vec3& f_after, const Vec3& g_after,
+                 double min_cos = kMinAdjacentCos);
 
 /// True when `after` (unnormalised normal) agrees with `before`: both non-zero and the angle between
 /// them is below acos(min_cos).
@@ -92,6 +95,8 @@ double star_min_angle(const TriMesh& mesh, OpenMesh::VertexHandle v);
 
 /// Would moving v to `p` keep every face of its star unfolded and non-degenerate? A new face may
 /// be below kMinAngle only if it is no worse than the worst face of the star before the move.
-bool move_is_safe(const TriMesh& mesh, OpenMesh::VertexHandle v, const Vec3& p);
+/// Adjacent pairs are judged by adjacent_ok() with `min_adjacent_cos`.
+bool move_is_safe(const TriMesh& mesh, OpenMesh::VertexHandle v, const Vec3& p,
+                  double min_adjacent_cos = kMinAdjacentCos);
 
 }  // namespace remesh::geom
