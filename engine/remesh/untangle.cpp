@@ -329,10 +329,34 @@ class Untangler {
       return true;
     };
     for (std::size_t i = 0; i < disk.inner.size(); ++i) mesh_.point(disk.inner[i]) = projected[i];
-    if (sound(disk)) return keep();
+    if (sound(disk) && covers(disk, start)) return keep();
     for (std::size_t i = 0; i < disk.inner.size(); ++i) mesh_.point(disk.inner[i]) = membrane[i];
-    if (sound(disk)) return keep();
+    if (sound(disk) && covers(disk, start)) return keep();
     return restore();
+  }
+
+  /// Does the disk, as the mesh holds it now, still pass within kMaxFlattening e_min of each of
+  /// `points` (its inner vertices' positions before)? Those lay on the surface (every vertex of a
+  /// run is projected onto the reference), so a disk that leaves one farther has cut a part of the
+  /// surface away rather than flattened a pleat: the membrane of a disk whose rim girds a thin
+  /// protrusion (a leg, a finger) spans the protrusion at the rim, and projected it lies on the
+  /// protrusion's sides, within e_min of the reference, with the protrusion's end gone.
+  bool covers(const Disk& disk, const std::vector<Vec3>& points) const {
+    const double limit2 = kMaxFlattening * e_min_ * kMaxFlattening * e_min_;
+    for (const Vec3& p : points) {
+      bool near = false;
+      for (auto f : disk.faces) {
+        OpenMesh::VertexHandle c[3];
+        geom::face_vertices(mesh_, f, c);
+        const Vec3 q = geom::closest_point_on_triangle(p, mesh_.point(c[0]), mesh_.point(c[1]), mesh_.point(c[2]));
+        if ((q - p).sqrnorm() <= limit2) {
+          near = true;
+          break;
+        }
+      }
+      if (!near) return false;
+    }
+    return true;
   }
 
   /// Is the disk, as the mesh holds it now, free of folds (a face turned away from the rim's

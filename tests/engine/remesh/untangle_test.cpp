@@ -230,3 +230,71 @@ TEST_CASE("untangle makes no pair of adjacent faces sharper than an edit may", "
   }
   CHECK(flattened >= 5);
 }
+
+namespace {
+
+/// A closed finger along z: `rings` rings of `sectors` vertices of radius `radius`, `spacing`
+/// apart (staggered by half a sector, so that no three corners lie on a line), capped by an apex
+/// `spacing` above the last ring and a centre vertex `spacing` below the first.
+TriMesh make_finger(double radius, double spacing, int rings, int sectors) {
+  TriMesh m;
+  const double pi = std::acos(-1.0);
+  std::vector<std::vector<OpenMesh::VertexHandle>> ring(rings);
+  for (int i = 0; i < rings; ++i)
+    for (int k = 0; k < sectors; ++k) {
+      const double a = 2 * pi * (k + 0.5 * (i % 2)) / sectors;
+      ring[i].push_back(m.add_vertex(Vec3(radius * std::cos(a), radius * std::sin(a), i * spacing)));
+    }
+  const auto apex = m.add_vertex(Vec3(0, 0, rings * spacing)), base = m.add_vertex(Vec3(0, 0, -spacing));
+  for (int k = 0; k < sectors; ++k) {
+    const int l = (k + 1) % sectors;
+    for (int i = 0; i + 1 < rings; ++i) {
+      // Rings alternate their stagger: the diagonal runs to the nearer corner of the next ring.
+      if (i % 2 == 0) {
+        m.add_face(ring[i][k], ring[i][l], ring[i + 1][k]);
+        m.add_face(ring[i][l], ring[i + 1][l], ring[i + 1][k]);
+      } else {
+        m.add_face(ring[i][k], ring[i + 1][l], ring[i + 1][k]);
+        m.add_face(ring[i][k], ring[i][l], ring[i + 1][l]);
+      }
+    }
+    m.add_face(ring[rings - 1][k], ring[rings - 1][l], apex);
+    m.add_face(ring[0][l], ring[0][k], base);
+  }
+  return m;
+}
+
+}  // namespace
+
+TEST_CASE("untangle never cuts a thin protrusion off: the finger's tip stays near the mesh", "[untangle]") {
+  // A finger 0.5 thick and 9 long is the reference. In the mesh its tip is crumpled at random
+  // (vertices within 2 of the apex moved by up to 0.5 in each direction) so that faces cross. A
+  // disk whose rim girds the finger below the tangle would flatten into a membrane across the
+  // finger, within e_min of its sides, with the tip gone: untangle may leave crossings, but every
+  // vertex position it had stays within e_min (1.2) of the mesh, the apex's included.
+  const TriMesh reference = make_finger(0.5, 0.75, 12, 8);
+  const ReferenceSurface surface(reference);
+  REQUIRE(test::check_mesh_valid(reference) == "");
+  const Vec3 apex(0, 0, 9.0);
+  int tangled = 0, flattened = 0;
+  for (unsigned seed = 1; seed <= 30; ++seed) {
+    INFO("seed " << seed);
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<double> d(-0.5, 0.5);
+    TriMesh mesh = reference;
+    for (auto v : mesh.vertices())
+      if ((reference.point(v) - apex).norm() < 2.0) mesh.point(v) += Vec3(d(rng), d(rng), d(rng));
+    if (find_self_intersections(mesh, 1).empty()) continue;
+    ++tangled;
+    const TriMesh before = mesh;
+    const UntangleCounts counts = untangle(mesh, surface, 1.2, 1.8, 1);
+    CHECK(counts.left == find_self_intersections(mesh, 1));
+    flattened += counts.flattened > 0;
+    for (auto v : before.vertices()) CHECK(test::brute_distance(mesh, before.point(v)) <= 1.2 + 1e-9);
+    CHECK(test::brute_distance(mesh, apex) <= 1.2);
+  }
+  CHECK(tangled >= 10);
+  // A disk that keeps the finger is still flattened (measured: 1 of 27 draws; without the rule, 16
+  // were, their tips cut off by 1.6 to 3.8).
+  CHECK(flattened > 0);
+}
