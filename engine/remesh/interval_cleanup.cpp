@@ -262,7 +262,7 @@ class Cleanup {
 
   bool collapse_at(EdgeHandle e, double plan_limit, bool free_placement) {
     CollapsePlan plan;
-    if (!plan_collapse(mesh_, e, target(), plan_limit, plan)) return false;
+    if (!plan_collapse(mesh_, e, target(), plan_limit, plan, /*keep_tips=*/false)) return false;
     const VertexHandle kept = mesh_.to_vertex_handle(plan.halfedge);
     const VertexHandle removed = mesh_.from_vertex_handle(plan.halfedge);
     const bool on_boundary = mesh_.is_boundary(kept) || mesh_.is_boundary(removed);
