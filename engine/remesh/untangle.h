@@ -14,7 +14,7 @@
 ///   if it passes within e_min of every position its vertices had: a disk whose rim girds a thin
 ///   protrusion would otherwise span it there and cut its end off (cow.obj, simplification setup:
 ///   a leg 6 units shorter, Hausdorff 5.6 -> 14.9 % of the bbox diagonal, on a run whose cleanup
-///   took another path). Such a tangle stays as it is.
+///   took another path). A tangle no disk passes for stays as it is.
 /// Measured (Table 4.2 setup): nefertiti's output had 14 crossing face pairs on its base where the
 /// input and CGAL's output have none.
 
