@@ -55,7 +55,8 @@ const std::vector<ParamSpec>& param_specs() {
       {"emin", Kind::Real, true},           {"emax", Kind::Real, true},
       {"iterations", Kind::Integer, false}, {"rings", Kind::Integer, false},
       {"relax_every", Kind::Integer, false}, {"flip_factor", Kind::Real, false},
-      {"run_all_iterations", Kind::Boolean, false}, {"weld", Kind::Boolean, false},
+      {"run_all_iterations", Kind::Boolean, false}, {"protect_tips", Kind::Boolean, false},
+      {"weld", Kind::Boolean, false},
   };
   return specs;
 }
@@ -76,6 +77,7 @@ void store(ParsedParams& out, std::string_view name, const Value& v) {
   else if (name == "relax_every") p.relax_every = static_cast<int>(v.integer);
   else if (name == "flip_factor") p.flip_factor = v.real;
   else if (name == "run_all_iterations") p.run_all_iterations = v.boolean;
+  else if (name == "protect_tips") p.protect_tips = v.boolean;
   else if (name == "weld") out.weld = v.boolean;
 }
 
@@ -227,7 +229,8 @@ void to_json(json& j, const Params& p) {
            {"rings", p.rings},
            {"relax_every", p.relax_every},
            {"flip_factor", p.flip_factor},
-           {"run_all_iterations", p.run_all_iterations}};
+           {"run_all_iterations", p.run_all_iterations},
+           {"protect_tips", p.protect_tips}};
 }
 
 void to_json(json& j, const FieldError& e) { j = json{{"field", e.field}, {"message", e.message}}; }

@@ -183,6 +183,7 @@ void untangle_and_mend(TriMesh& mesh, const ReferenceSurface& reference, const P
     options.rounds = kFinalCleanupRounds;
     options.patch_budget = final_patch_budget(mesh);
     options.caches = &caches;
+    options.protect_tips = params.protect_tips;
     const CleanupCounts c = interval_cleanup(mesh, reference, params.e_min, params.e_max, params.flip_factor, options);
     count_cleanup(row, c);
     // Again only if the cleanup made faces cross that did not before (the pairs it left alone
@@ -328,6 +329,7 @@ Result equalize(TriMesh& mesh, const Params& params, const OnIteration& on_itera
         options.rounds = kCleanupRounds;
         options.boundary_only = !full;
         options.caches = &neighbour_caches;
+        options.protect_tips = params.protect_tips;
         count_cleanup(counters, interval_cleanup(mesh, *reference, params.e_min, params.e_max, params.flip_factor,
                                                  options));
       }
@@ -387,6 +389,7 @@ Result equalize(TriMesh& mesh, const Params& params, const OnIteration& on_itera
           options.rounds = kFinalCleanupRounds;
           options.patch_budget = final_patch_budget(mesh);
           options.caches = &neighbour_caches;
+        options.protect_tips = params.protect_tips;
           const CleanupCounts c =
               interval_cleanup(mesh, *reference, params.e_min, params.e_max, params.flip_factor, options);
           if (fixes(c) > 0) {

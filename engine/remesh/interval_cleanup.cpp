@@ -161,6 +161,7 @@ class Cleanup {
 
   void set_patch_budget(std::size_t budget) { patch_budget_ = budget; }
   void set_remember_failures(bool on) { remember_failures_ = on; }
+  void set_protect_tips(bool on) { protect_tips_ = on; }
 
   NeighbourCache* cache_of(VertexHandle v) {
     return caches_ && static_cast<std::size_t>(v.idx()) < caches_->size() ? &(*caches_)[v.idx()] : nullptr;
@@ -262,11 +263,12 @@ class Cleanup {
 
   bool collapse_at(EdgeHandle e, double plan_limit, bool free_placement) {
     CollapsePlan plan;
-    if (!plan_collapse(mesh_, e, target(), plan_limit, plan, /*keep_tips=*/false)) return false;
+    if (!plan_collapse(mesh_, e, target(), plan_limit, plan, /*keep_tips=*/protect_tips_)) return false;
     const VertexHandle kept = mesh_.to_vertex_handle(plan.halfedge);
     const VertexHandle removed = mesh_.from_vertex_handle(plan.halfedge);
     const bool on_boundary = mesh_.is_boundary(kept) || mesh_.is_boundary(removed);
     if (free_placement && on_boundary) return false;  // a boundary vertex stays where plan_collapse put it
+    if (free_placement && protect_tips_ && is_tip(mesh_, kept) && plan.position == mesh_.point(kept)) return false;
     const Vec3 normal = geom::vertex_normal(mesh_, kept) + geom::vertex_normal(mesh_, removed);
     Vec3 p = plan.position;
     if (free_placement) p = settle(p, collapse_neighbours(mesh_, plan.halfedge), normal);
@@ -384,6 +386,7 @@ class Cleanup {
   }
 
   bool relocate(VertexHandle v) {
+    if (protect_tips_ && is_tip(mesh_, v)) return false;
     const bool boundary = mesh_.is_boundary(v);
     const Vec3 tangent = boundary ? boundary_tangent(v) : Vec3(0, 0, 0);
     if (boundary && tangent.sqrnorm() == 0) return false;
@@ -517,7 +520,8 @@ class Cleanup {
       moved = 0;
       for (std::size_t i = 0; i < patch.size(); ++i) {
         const VertexHandle v = patch[i];
-        if (v == pinned || mesh_.is_boundary(v)) continue;
+        // A snap (judged) may move a tip: it moves vertices onto the input's own points.
+        if (v == pinned || mesh_.is_boundary(v) || (protect_tips_ && !judge && is_tip(mesh_, v))) continue;
         ring.clear();
         for (auto w : mesh_.vv_range(v)) ring.push_back(mesh_.point(w));
         const Vec3 n = geom::vertex_normal(mesh_, v);
@@ -588,6 +592,7 @@ class Cleanup {
   const ReferenceSurface& reference_;
   double e_min_, e_max_, f_;
   bool collapsed_ = false;              ///< deleted elements to collect (finish)
+  bool protect_tips_ = false;            ///< CleanupOptions::protect_tips
   bool collapsed_since_round_ = false;  ///< a collapse in the current round
   std::vector<Vec3> ring_;        ///< a vertex's 1-ring points, for relocate and relax_patch (reused buffer)
   std::vector<char> patch_mark_;  ///< grow_rings' membership flags, all zero between calls
@@ -625,6 +630,7 @@ CleanupCounts interval_cleanup(TriMesh& mesh, const ReferenceSurface& reference,
   Cleanup cleanup(mesh, reference, e_min, e_max, flip_factor, options.caches);
   if (options.patch_budget > 0) cleanup.set_patch_budget(options.patch_budget);
   cleanup.set_remember_failures(options.remember_failures);
+  cleanup.set_protect_tips(options.protect_tips);
   CleanupCounts counts;
   counts.outside_before = cleanup.count_outside();
   if (counts.outside_before > 0)

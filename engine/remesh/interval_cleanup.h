@@ -54,6 +54,9 @@ struct CleanupOptions {
   /// since, and a relocation that failed, while nothing within 2 rings of its vertex has (each
   /// would fail again). The result is the same either way; off only to check that.
   bool remember_failures = true;
+  /// Params::protect_tips: tips (is_tip) are never moved (collapses keep them, relocations and
+  /// patch relaxations pass them over).
+  bool protect_tips = false;
 };
 
 /// Runs the cleanup. Precondition: no deleted elements (garbage-collected); it leaves the mesh

@@ -22,7 +22,7 @@ std::set<std::string> fields_of(const std::vector<FieldError>& errors) {
 
 TEST_CASE("params_from_json: valid documents parse into Params", "[api][params]") {
   ParsedParams p = params_from_json(json::parse(
-      R"({"emin":0.5,"emax":1.5,"iterations":7,"rings":3,"relax_every":2,"flip_factor":0.25,"run_all_iterations":true,"weld":true})"));
+      R"({"emin":0.5,"emax":1.5,"iterations":7,"rings":3,"relax_every":2,"flip_factor":0.25,"run_all_iterations":true,"protect_tips":true,"weld":true})"));
   REQUIRE(p.ok());
   CHECK(p.params.e_min == 0.5);
   CHECK(p.params.e_max == 1.5);
@@ -31,12 +31,14 @@ TEST_CASE("params_from_json: valid documents parse into Params", "[api][params]"
   CHECK(p.params.relax_every == 2);
   CHECK(p.params.flip_factor == 0.25);
   CHECK(p.params.run_all_iterations);
+  CHECK(p.params.protect_tips);
   CHECK(p.weld);
 
   ParsedParams d = params_from_json(json::parse(R"({"emin":1,"emax":2,"iterations":5.0})"));
   REQUIRE(d.ok());
   CHECK(d.params.iterations == 5);
   CHECK(d.params.rings == Params{}.rings);
+  CHECK_FALSE(d.params.protect_tips);
   CHECK_FALSE(d.weld);
 }
 
@@ -53,6 +55,7 @@ TEST_CASE("params_from_json: every bad field is reported", "[api][params]") {
       {R"({"emin":1,"emax":2,"iterations":"ten","rings":[1]})", {"iterations", "rings"}},
       {R"({"emin":1,"emax":2,"run_all_iterations":"yes"})", {"run_all_iterations"}},
       {R"({"emin":1,"emax":2,"weld":1})", {"weld"}},
+      {R"({"emin":1,"emax":2,"protect_tips":"true"})", {"protect_tips"}},
       {R"({"emin":1,"emax":2,"flip_factor":null})", {"flip_factor"}},
       {R"({"emin":1,"emax":2,"iterations":99999999999})", {"iterations"}},
       {R"({"emin":1,"emax":2,"colour":"red"})", {"colour"}},
@@ -91,6 +94,7 @@ TEST_CASE("params_from_query: strings parse strictly", "[api][params]") {
       {{{"emin", "1"}, {"emax", "2"}, {"iterations", "2.5"}}, {"iterations"}},
       {{{"emin", "1"}, {"emax", "2"}, {"rings", ""}}, {"rings"}},
       {{{"emin", "1"}, {"emax", "2"}, {"run_all_iterations", "maybe"}}, {"run_all_iterations"}},
+      {{{"emin", "1"}, {"emax", "2"}, {"protect_tips", "2"}}, {"protect_tips"}},
       {{{"emin", "1"}, {"emax", "2"}, {"format", "obj"}}, {"format"}},  // not ignored here
       {{{"emin", "1"}, {"emax", "2"}, {"itrations", "3"}}, {"itrations"}},
   };
@@ -106,14 +110,17 @@ TEST_CASE("Params and summaries map to the documented JSON names", "[api][json]"
   Params p;
   p.e_min = 0.1;
   p.e_max = 0.2;
+  p.protect_tips = true;
   json j = p;
-  for (const char* k : {"emin", "emax", "iterations", "rings", "relax_every", "flip_factor", "run_all_iterations"})
+  for (const char* k :
+       {"emin", "emax", "iterations", "rings", "relax_every", "flip_factor", "run_all_iterations", "protect_tips"})
     CHECK(j.contains(k));
   CHECK(j["emin"] == 0.1);
   // Round trip through the parser.
   ParsedParams back = params_from_json(j);
   REQUIRE(back.ok());
   CHECK(back.params.e_max == 0.2);
+  CHECK(back.params.protect_tips);
 
   MeshSummary s;
   s.vertices = 12;

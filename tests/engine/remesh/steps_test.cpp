@@ -464,6 +464,52 @@ TEST_CASE("the interval cleanup is safe, keeps vertices on the reference and is 
   for (auto v : inside.vertices()) CHECK(inside.point(v) == copy.point(v));
 }
 
+TEST_CASE("with protect_tips the interval cleanup moves no tip", "[steps]") {
+  // Spheres with six spikes (vertices pulled out to 1.15-1.25 times the radius: tips, is_tip),
+  // scaled to a mean edge of 1.45, so that the spikes' edges are too long for [1.2, 1.8]. With
+  // protect_tips each tip's position is still a vertex of the mesh afterwards, the cleanup
+  // mending what it can around them; without it the cleanup takes some of them away (measured:
+  // the patch relaxations move every tip of the 1.25 spikes). The meshes stay valid either way.
+  std::size_t kept_without = 0, tips = 0, fixes = 0;  // fixes: edges mended with protect_tips
+  for (const double spike : {1.15, 1.2, 1.25}) {
+    INFO("spike " << spike);
+    TriMesh base = test::make_icosphere(3, 1.0);
+    for (int i = 0; i < 12; i += 2) base.point(base.vertex_handle(i)) *= spike;
+    test::scale_mean_edge(base, 1.45);
+    std::vector<Vec3> tip_points;
+    for (auto v : base.vertices())
+      if (is_tip(base, v)) tip_points.push_back(base.point(v));
+    REQUIRE(tip_points.size() == 6);
+    const ReferenceSurface reference(base);
+    auto count_kept = [&](const TriMesh& m) {
+      std::size_t n = 0;
+      for (const Vec3& t : tip_points) {
+        bool found = false;
+        for (auto v : m.vertices()) found = found || m.point(v) == t;
+        n += found;
+      }
+      return n;
+    };
+    for (const bool protect : {true, false}) {
+      TriMesh mesh = base;
+      CleanupOptions options;
+      options.rounds = 6;
+      options.protect_tips = protect;
+      const CleanupCounts c = interval_cleanup(mesh, reference, 1.2, 1.8, 0.5, options);
+      CHECK(test::check_mesh_valid(mesh) == "");
+      if (protect) {
+        fixes += c.outside_before - c.outside_after;
+        CHECK(count_kept(mesh) == tip_points.size());
+      } else {
+        kept_without += count_kept(mesh);
+      }
+    }
+    tips += tip_points.size();
+  }
+  CHECK(fixes > 10);  // the cleanup still mends edges (splitting those at the tips)
+  CHECK(kept_without < tips);
+}
+
 TEST_CASE("a mesh snapshot rebuilds the live vertices and faces in their order", "[steps]") {
   TriMesh mesh = test::make_torus(20, 10, 3.0, 1.0);
   // Delete a few elements without garbage collection, as a run leaves them between steps.
