@@ -389,7 +389,7 @@ Result equalize(TriMesh& mesh, const Params& params, const OnIteration& on_itera
           options.rounds = kFinalCleanupRounds;
           options.patch_budget = final_patch_budget(mesh);
           options.caches = &neighbour_caches;
-        options.protect_tips = params.protect_tips;
+          options.protect_tips = params.protect_tips;
           const CleanupCounts c =
               interval_cleanup(mesh, *reference, params.e_min, params.e_max, params.flip_factor, options);
           if (fixes(c) > 0) {
