@@ -3,9 +3,11 @@
 
 #include <cmath>
 #include <fstream>
+#include <iterator>
 #include <regex>
 #include <set>
 
+#include "api/json_codec.h"
 #include "daemon.h"
 #include "routes.h"
 
@@ -15,14 +17,6 @@ using namespace remesh::test;
 namespace {
 
 json body_of(const httplib::Result& r) { return json::parse(r->body); }
-
-std::string submit_ok(httplib::Client& c, const std::string& mesh, const std::string& query) {
-  auto r = submit_raw(c, mesh, query);
-  REQUIRE(r);
-  INFO(r->body);
-  REQUIRE(r->status == 202);
-  return body_of(r)["id"];
-}
 
 std::set<std::string> error_fields(const httplib::Result& r) {
   std::set<std::string> s;
@@ -280,6 +274,25 @@ TEST_CASE("remeshd: the errors each route must give", "[server]") {
   auto late = c.Get(("/api/v1/jobs/" + id + "/result?mesh=dual&format=obj").c_str());
   CHECK(late->status == 409);
   CHECK(body_of(late)["state"] == "cancelled");
+}
+
+TEST_CASE("remeshd: api/openapi.yaml documents every job parameter the codec reads and echoes", "[server][openapi]") {
+  // The names come from the codec itself: the echo of a job's params (to_json) plus the read option
+  // weld. Each must be a query parameter of POST /jobs and a property of ParamsInput.
+  std::ifstream in(REMESHD_OPENAPI);
+  REQUIRE(in);
+  const std::string yaml((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::size_t input = yaml.find("    ParamsInput:");
+  REQUIRE(input != std::string::npos);
+  const std::string params_input = yaml.substr(input, yaml.find("\n    IterationStats:", input) - input);
+  nlohmann::json echoed = remesh::Params{};
+  echoed["weld"] = false;
+  REQUIRE(echoed.size() >= 9);
+  for (const auto& [name, value] : echoed.items()) {
+    INFO(name);
+    CHECK(yaml.find("- {name: " + name + ", in: query") != std::string::npos);
+    CHECK(params_input.find("        " + name + ": {type:") != std::string::npos);
+  }
 }
 
 TEST_CASE("remeshd: the routes in api/openapi.yaml are the routes the server serves", "[server][openapi]") {
