@@ -267,8 +267,9 @@ class Cleanup {
     const VertexHandle kept = mesh_.to_vertex_handle(plan.halfedge);
     const VertexHandle removed = mesh_.from_vertex_handle(plan.halfedge);
     const bool on_boundary = mesh_.is_boundary(kept) || mesh_.is_boundary(removed);
-    if (free_placement && on_boundary) return false;  // a boundary vertex stays where plan_collapse put it
-    if (free_placement && protect_tips_ && is_tip(mesh_, kept) && plan.position == mesh_.point(kept)) return false;
+    // A vertex plan_collapse keeps in place (a boundary end, a protected tip) stays there; a
+    // boundary edge collapses along the boundary only.
+    if (free_placement && (on_boundary || plan.kept_in_place)) return false;
     const Vec3 normal = geom::vertex_normal(mesh_, kept) + geom::vertex_normal(mesh_, removed);
     Vec3 p = plan.position;
     if (free_placement) p = settle(p, collapse_neighbours(mesh_, plan.halfedge), normal);

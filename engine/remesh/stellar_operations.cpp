@@ -144,14 +144,17 @@ bool plan_collapse(const TriMesh& mesh, EdgeHandle e, double target, double max_
   // is_collapse_ok is not const in OpenMesh 9 but only reads (it uses status bits it resets).
   if (!const_cast<TriMesh&>(mesh).is_collapse_ok(h)) return false;
   Vec3 p;
+  plan.kept_in_place = false;
   if (keep_end) {
     p = mesh.point(v1);  // the tip stays
+    plan.kept_in_place = true;
   } else if (along_boundary || !(b0 || b1)) {
     // On the edge at the eq. 3.1 parameter (for a boundary edge, on the boundary curve).
     const Vec3 a = mesh.point(v0), b = mesh.point(v1);
     p = a + (b - a) * equalizing_parameter(a, b, collapse_neighbours(mesh, h), target);
   } else {
     p = mesh.point(v1);  // the boundary end stays
+    plan.kept_in_place = true;
   }
   if (!collapse_geometry_ok(mesh, h, p, max_length)) return false;
   plan.halfedge = h;

@@ -33,6 +33,9 @@ OpenMesh::VertexHandle split_edge(TriMesh& mesh, OpenMesh::EdgeHandle e, double 
 struct CollapsePlan {
   OpenMesh::HalfedgeHandle halfedge;
   Vec3 position;
+  /// The kept vertex stays where it is (a boundary vertex an interior one collapses onto, or a
+  /// kept tip): a later placement must not move it.
+  bool kept_in_place = false;
 };
 
 /// Angle deficit (radians) above which an interior vertex is a tip (is_tip): the apex of a cone
@@ -51,7 +54,10 @@ struct CollapsePlan {
 /// gain less.
 constexpr double kTipDeficit = 1.5;
 
-/// Is v an interior vertex with an angle deficit above kTipDeficit?
+/// Is v an interior vertex with an angle deficit above kTipDeficit? (The filter's is_corner,
+/// low_pass_filter.h, holds still every vertex with |deficit| > 1 rad, saddles included; as the
+/// collapse rule it kept fewer tips: five-interval means, before the check of the new neighbours,
+/// cow simplification 2.56 % with this rule, 3.85 % with that one.)
 bool is_tip(const TriMesh& mesh, OpenMesh::VertexHandle v);
 
 /// Chooses direction and position (eq. 3.1, the boundary vertex or the tip, see above) for
