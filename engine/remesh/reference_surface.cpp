@@ -24,12 +24,37 @@ struct Csr {
 
 }  // namespace
 
+/// Triangles a query has looked at already (each is incident to up to three of the nearest
+/// vertices), per thread: stamp[t] == the query's epoch. 4 bytes per reference triangle and
+/// thread, kept for the thread's next query on the same surface.
+struct Seen {
+  std::uint64_t surface = 0;
+  std::uint32_t epoch = 0;
+  std::vector<std::uint32_t> stamp;
+  /// A fresh epoch for a query on `surface` with `triangles` triangles.
+  std::uint32_t next(std::uint64_t id, std::size_t triangles) {
+    if (surface != id || stamp.size() != triangles || ++epoch == 0) {
+      stamp.assign(triangles, 0);
+      surface = id;
+      epoch = 1;
+    }
+    return epoch;
+  }
+};
+
 struct ReferenceSurface::Impl {
   std::vector<Vec3> points;
-  std::vector<std::array<std::uint32_t, 3>> triangles;
-  std::vector<Vec3> unit_normals;   ///< per triangle
-  std::vector<Vec3> centres;        ///< per triangle: centroid
-  std::vector<double> radii;        ///< per triangle: largest distance centroid -> corner
+  /// What a query reads of a triangle, in one record (one or two cache lines instead of four arrays:
+  /// the candidate loop of closest_point visits ~180 triangles per query, scattered in memory).
+  struct Triangle {
+    Vec3 centre;                          ///< centroid
+    double radius = 0;                    ///< largest distance centroid -> corner
+    Vec3 normal;                          ///< unit normal (zero for a degenerate triangle)
+    std::array<std::uint32_t, 3> corners{};
+    /// folded back onto a larger neighbour (see kFoldCos); never a candidate
+    std::uint32_t folded = 0;
+  };
+  std::vector<Triangle> triangles;
   Csr vertex_triangles;             ///< triangles incident to each vertex
   /// per vertex: its longest incident edge, so every incident triangle lies within this distance
   std::vector<double> vertex_reach;
@@ -37,8 +62,6 @@ struct ReferenceSurface::Impl {
   /// per triangle: the triangle across its edge (corner k, corner k+1), or kNone (boundary edge)
   std::vector<std::array<std::uint32_t, 3>> across;
   static constexpr std::uint32_t kNone = UINT32_MAX;
-  /// per triangle: folded back onto a larger neighbour (see kFoldCos); never a candidate
-  std::vector<std::uint8_t> folded;
   Csr vertex_boundary;              ///< other end of each boundary edge at a vertex
   std::size_t boundary_edges = 0;
   std::size_t neighbours = 30;
@@ -107,7 +130,8 @@ ReferenceSurface::ReferenceSurface(const TriMesh& mesh, std::size_t neighbours)
     face_index[f.idx()] = static_cast<std::uint32_t>(m.triangles.size());
     OpenMesh::VertexHandle c[3];
     geom::face_vertices(mesh, f, c);
-    std::array<std::uint32_t, 3> t{index[c[0].idx()], index[c[1].idx()], index[c[2].idx()]};
+    Impl::Triangle t;
+    t.corners = {index[c[0].idx()], index[c[1].idx()], index[c[2].idx()]};
     m.triangles.push_back(t);
   }
   // Triangles across each edge, from the mesh's halfedges: corners c0, c1, c2 are the ends of
@@ -126,27 +150,24 @@ ReferenceSurface::ReferenceSurface(const TriMesh& mesh, std::size_t neighbours)
   }
   if (m.triangles.empty()) throw MeshError("reference surface has no triangles");
   const std::size_t nv = m.points.size(), nt = m.triangles.size();
-  m.unit_normals.resize(nt);
-  m.centres.resize(nt);
-  m.radii.resize(nt);
   std::vector<double> areas(nt);
   m.vertex_triangles.offsets.assign(nv + 1, 0);
   for (std::size_t t = 0; t < nt; ++t) {
-    const auto& tri = m.triangles[t];
-    const Vec3 &a = m.points[tri[0]], &b = m.points[tri[1]], &c = m.points[tri[2]];
+    Impl::Triangle& tri = m.triangles[t];
+    const Vec3 &a = m.points[tri.corners[0]], &b = m.points[tri.corners[1]], &c = m.points[tri.corners[2]];
     Vec3 n = geom::cross_normal(a, b, c);
     const double len = n.norm();
-    m.unit_normals[t] = len > 0 ? n / len : Vec3(0, 0, 0);
+    tri.normal = len > 0 ? n / len : Vec3(0, 0, 0);
     areas[t] = 0.5 * len;
-    m.centres[t] = (a + b + c) / 3.0;
-    m.radii[t] = std::sqrt(std::max({(a - m.centres[t]).sqrnorm(), (b - m.centres[t]).sqrnorm(),
-                                      (c - m.centres[t]).sqrnorm()}));
-    for (auto v : tri) ++m.vertex_triangles.offsets[v + 1];
+    tri.centre = (a + b + c) / 3.0;
+    tri.radius = std::sqrt(std::max({(a - tri.centre).sqrnorm(), (b - tri.centre).sqrnorm(),
+                                     (c - tri.centre).sqrnorm()}));
+    for (auto v : tri.corners) ++m.vertex_triangles.offsets[v + 1];
   }
   m.vertex_reach.assign(nv, 0.0);
   for (const auto& tri : m.triangles)
     for (int k = 0; k < 3; ++k) {
-      const std::uint32_t a = tri[k], b = tri[(k + 1) % 3];
+      const std::uint32_t a = tri.corners[k], b = tri.corners[(k + 1) % 3];
       const double l = (m.points[a] - m.points[b]).norm();
       m.vertex_reach[a] = std::max(m.vertex_reach[a], l);
       m.vertex_reach[b] = std::max(m.vertex_reach[b], l);
@@ -157,7 +178,7 @@ ReferenceSurface::ReferenceSurface(const TriMesh& mesh, std::size_t neighbours)
   {
     std::vector<std::uint32_t> fill(m.vertex_triangles.offsets.begin(), m.vertex_triangles.offsets.end() - 1);
     for (std::size_t t = 0; t < nt; ++t)
-      for (auto v : m.triangles[t]) m.vertex_triangles.items[fill[v]++] = static_cast<std::uint32_t>(t);
+      for (auto v : m.triangles[t].corners) m.vertex_triangles.items[fill[v]++] = static_cast<std::uint32_t>(t);
   }
   // A triangle whose normal is nearly opposite to that of a larger neighbour across an edge lies
   // folded back onto it: a defect of the input (nefertiti has 96 such pairs: slivers that close
@@ -167,13 +188,12 @@ ReferenceSurface::ReferenceSurface(const TriMesh& mesh, std::size_t neighbours)
   // row of smaller triangles along its edge the same way (none among the shared meshes; the rule
   // does not check that the larger triangle covers the smaller one).
   constexpr double kFoldCos = -0.95;
-  m.folded.assign(nt, 0);
   for (std::size_t t = 0; t < nt; ++t)
     for (int k = 0; k < 3; ++k) {
       const std::uint32_t u = m.across[t][k];
-      if (u != Impl::kNone && (m.unit_normals[t] | m.unit_normals[u]) < kFoldCos &&
+      if (u != Impl::kNone && (m.triangles[t].normal | m.triangles[u].normal) < kFoldCos &&
           areas[u] > areas[t])
-        m.folded[t] = 1;
+        m.triangles[t].folded = 1;
     }
   // Boundary edges, listed at both ends.
   m.vertex_boundary.offsets.assign(nv + 1, 0);
@@ -226,10 +246,10 @@ double ReferenceSurface::opposite_side_distance(const Vec3& p, const Vec3& norma
     const double reach = limit + m.vertex_reach[v];
     if (d2 > reach * reach) continue;
     for (std::uint32_t j = m.vertex_triangles.offsets[v]; j < m.vertex_triangles.offsets[v + 1]; ++j) {
-      const std::uint32_t t = m.vertex_triangles.items[j];
-      if ((m.unit_normals[t] | normal) >= kOpposite) continue;
-      const auto& tri = m.triangles[t];
-      const Vec3 c = geom::closest_point_on_triangle(p, m.points[tri[0]], m.points[tri[1]], m.points[tri[2]]);
+      const Impl::Triangle& tri = m.triangles[m.vertex_triangles.items[j]];
+      if ((tri.normal | normal) >= kOpposite) continue;
+      const Vec3 c = geom::closest_point_on_triangle(p, m.points[tri.corners[0]], m.points[tri.corners[1]],
+                                                     m.points[tri.corners[2]]);
       const double c2 = (c - p).sqrnorm();
       if (c2 < best2) best2 = c2, any = true;
     }
@@ -267,6 +287,8 @@ Vec3 ReferenceSurface::Impl::closest_point(const Vec3& p, const Vec3& normal_hin
   Vec3 best = m.points[idx[0]], best_agree = best;
   double best_d2 = kInf, agree_d2 = kInf, best_d = kInf, agree_d = kInf;
   std::uint32_t best_t = kNone, agree_t = kNone;
+  thread_local Seen seen;
+  const std::uint32_t epoch = seen.next(id, triangles.size());
   for (std::size_t i = 0; i < found; ++i) {
     const std::uint32_t v = idx[i];
     // Skip the vertex when all its triangles (within vertex_reach of it) are farther than any
@@ -278,21 +300,27 @@ Vec3 ReferenceSurface::Impl::closest_point(const Vec3& p, const Vec3& normal_hin
     }
     for (std::uint32_t j = m.vertex_triangles.offsets[v]; j < m.vertex_triangles.offsets[v + 1]; ++j) {
       const std::uint32_t t = m.vertex_triangles.items[j];
-      if (m.folded[t]) continue;
-      const bool agrees = use_hint && (m.unit_normals[t] | normal_hint) > 0;
+      // Once per query: a triangle passed over stays passed over (the bounds only shrink), and
+      // one measured cannot win again (strictly closer only). Same answers, half the visits
+      // (cheese: 175 -> 100 triangles a query; 4 % of its run).
+      if (seen.stamp[t] == epoch) continue;
+      seen.stamp[t] = epoch;
+      const Triangle& tri = m.triangles[t];
+      if (tri.folded) continue;
+      const bool agrees = use_hint && (tri.normal | normal_hint) > 0;
       // Skip a triangle whose bounding sphere is farther than the candidate it could beat.
       const double bound = agrees ? std::max(best_d, agree_d) : best_d;
       if (bound < kInf) {
-        const Vec3 from_centre = p - m.centres[t];
-        const double reach = m.radii[t] + bound;
+        const Vec3 from_centre = p - tri.centre;
+        const double reach = tri.radius + bound;
         if (from_centre.sqrnorm() > reach * reach) continue;
         // ... or whose plane is: a sliver's bounding sphere is wide (cheese.off: triangles 3.6 by
         // 0.17 around its holes; this test makes its run 15 % faster). The margin keeps the test
         // conservative against rounding.
-        if (std::abs(m.unit_normals[t] | from_centre) > bound * (1.0 + 1e-9) + 1e-12) continue;
+        if (std::abs(tri.normal | from_centre) > bound * (1.0 + 1e-9) + 1e-12) continue;
       }
-      const auto& tri = m.triangles[t];
-      const Vec3 c = geom::closest_point_on_triangle(p, m.points[tri[0]], m.points[tri[1]], m.points[tri[2]]);
+      const Vec3 c = geom::closest_point_on_triangle(p, m.points[tri.corners[0]], m.points[tri.corners[1]],
+                                                     m.points[tri.corners[2]]);
       const double d2 = (c - p).sqrnorm();
       if (d2 < best_d2) best_d2 = d2, best_d = std::sqrt(d2), best = c, best_t = t;
       if (agrees && d2 < agree_d2) agree_d2 = d2, agree_d = std::sqrt(d2), best_agree = c, agree_t = t;
@@ -332,10 +360,12 @@ void ReferenceSurface::Impl::walk(const Vec3& p, const Vec3& normal_hint, std::u
     double next_d2 = d2 * (1.0 - 1e-9);
     for (int k = 0; k < 3; ++k) {
       const std::uint32_t u = across[t][k];
-      if (u == kNone || folded[u] || (unit_normals[u] | unit_normals[t]) < kWalkCos) continue;
-      if (use_hint && (unit_normals[u] | normal_hint) <= 0) continue;
-      const auto& tri = triangles[u];
-      const Vec3 q = geom::closest_point_on_triangle(p, points[tri[0]], points[tri[1]], points[tri[2]]);
+      if (u == kNone) continue;
+      const Triangle& tri = triangles[u];
+      if (tri.folded || (tri.normal | triangles[t].normal) < kWalkCos) continue;
+      if (use_hint && (tri.normal | normal_hint) <= 0) continue;
+      const Vec3 q = geom::closest_point_on_triangle(p, points[tri.corners[0]], points[tri.corners[1]],
+                                                     points[tri.corners[2]]);
       const double e2 = (q - p).sqrnorm();
       if (e2 < next_d2) next = u, next_c = q, next_d2 = e2;
     }
