@@ -119,12 +119,16 @@ ReferenceSurface::ReferenceSurface(const TriMesh& mesh, std::size_t neighbours)
   Impl& m = *impl_;
   m.neighbours = std::max<std::size_t>(1, neighbours);
   std::vector<std::uint32_t> index(mesh.n_vertices(), UINT32_MAX);
+  // Reserved: a capacity doubled by push_back would hold up to twice the memory (bunny_zipper's
+  // peak: +10 MiB with the 72-byte triangle records).
+  m.points.reserve(mesh.n_vertices());
   for (auto v : mesh.vertices()) {
     if (mesh.status(v).deleted()) continue;
     index[v.idx()] = static_cast<std::uint32_t>(m.points.size());
     m.points.push_back(mesh.point(v));
   }
   std::vector<std::uint32_t> face_index(mesh.n_faces(), Impl::kNone);
+  m.triangles.reserve(mesh.n_faces());
   for (auto f : mesh.faces()) {
     if (mesh.status(f).deleted()) continue;
     face_index[f.idx()] = static_cast<std::uint32_t>(m.triangles.size());
