@@ -1,6 +1,7 @@
 #include "remesh/fold_guard.h"
 
 #include <algorithm>
+#include <cstdint>
 
 #include "core/parallel.h"
 #include "remesh/geometry.h"
@@ -79,6 +80,40 @@ std::size_t undo_folds(TriMesh& mesh, const std::vector<Vec3>& before, unsigned 
         if (face_is_bad(f, normal_before, fresh_now)) queue.push_back(f);
   }
   return restored;
+}
+
+std::size_t undo_interval_breaks(TriMesh& mesh, const std::vector<Vec3>& before, double e_min, double e_max,
+                                 int halvings) {
+  auto inside = [&](double length) { return length >= e_min && length <= e_max; };
+  auto broken = [&](OpenMesh::EdgeHandle e) {
+    const auto h = mesh.halfedge_handle(e, 0);
+    const auto a = mesh.from_vertex_handle(h), b = mesh.to_vertex_handle(h);
+    return !inside((mesh.point(a) - mesh.point(b)).norm()) && inside((before[a.idx()] - before[b.idx()]).norm());
+  };
+  std::vector<OpenMesh::EdgeHandle> queue;
+  for (auto e : mesh.edges())
+    if (!mesh.status(e).deleted() && broken(e)) queue.push_back(e);
+  std::vector<std::uint8_t> retreats(mesh.n_vertices(), 0);
+  std::size_t moves = 0;
+  while (!queue.empty()) {
+    std::vector<OpenMesh::VertexHandle> moved;
+    for (auto e : queue) {
+      if (!broken(e)) continue;  // mended by a move back of a neighbour in this round
+      const auto h = mesh.halfedge_handle(e, 0);
+      for (auto v : {mesh.from_vertex_handle(h), mesh.to_vertex_handle(h)}) {
+        const Vec3& was = before[v.idx()];
+        if (mesh.point(v) == was) continue;
+        mesh.point(v) = retreats[v.idx()]++ < halvings ? (mesh.point(v) + was) * 0.5 : was;
+        moved.push_back(v);
+        ++moves;
+      }
+    }
+    queue.clear();
+    for (auto v : moved)
+      for (auto e : mesh.ve_range(v))
+        if (broken(e)) queue.push_back(e);
+  }
+  return moves;
 }
 
 }  // namespace remesh

@@ -19,4 +19,11 @@ std::vector<Vec3> snapshot_points(const TriMesh& mesh);
 /// same connectivity). Returns how many vertices were restored.
 std::size_t undo_folds(TriMesh& mesh, const std::vector<Vec3>& before, unsigned threads);
 
+/// Not in the thesis: the same net for the interval, used once the interval cleanup has taken over
+/// (equalize.cpp, kSteadyAfter). Every edge that was inside [e_min, e_max] at `before` and is not
+/// now gets both ends moved half way back to `before` (`halvings` times at most, then all the way),
+/// repeatedly until no such edge is left. Returns the number of moves back.
+std::size_t undo_interval_breaks(TriMesh& mesh, const std::vector<Vec3>& before, double e_min, double e_max,
+                                 int halvings = 3);
+
 }  // namespace remesh

@@ -6,6 +6,7 @@
 #include <random>
 #include <vector>
 
+#include "remesh/fold_guard.h"
 #include "remesh/geometry.h"
 #include "remesh/interval_cleanup.h"
 #include "remesh/low_pass_filter.h"
@@ -371,6 +372,45 @@ TEST_CASE("the filter moves vertices tangentially only and never moves boundary 
       largest = std::max(largest, moves[v.idx()].norm());
     }
     CHECK(largest > 1e-4);
+  }
+}
+
+TEST_CASE("the interval guard moves back, half way at a time, what took edges out of the interval", "[steps]") {
+  // Every edge 1.5, inside [1.2, 1.8]; a random move of up to 0.35 per coordinate takes many out.
+  for (const int halvings : {0, 3}) {
+    TriMesh mesh = test::make_hex_lattice_patch(14, 14, 1.5);
+    const std::vector<Vec3> before = snapshot_points(mesh);
+    std::mt19937 rng(static_cast<unsigned>(17 + halvings));
+    std::uniform_real_distribution<double> jitter(-0.35, 0.35);
+    for (auto v : mesh.vertices()) mesh.point(v) += Vec3(jitter(rng), jitter(rng), 0);
+    const std::vector<Vec3> moved = snapshot_points(mesh);
+    const double broken_before = 1.0 - test::plain_inside_fraction(mesh, 1.2, 1.8);
+    REQUIRE(broken_before > 0.05);
+    const std::size_t moves = undo_interval_breaks(mesh, before, 1.2, 1.8, halvings);
+    CHECK(moves > 0);
+    // Every edge is inside again (all were inside before) ...
+    CHECK(test::plain_inside_fraction(mesh, 1.2, 1.8) == 1.0);
+    // ... and each vertex lies where it was, where it moved, or 1/2, 1/4 or 1/8 of the way (none of
+    // those with no halvings).
+    std::size_t kept = 0, back = 0, partly = 0;
+    for (auto v : mesh.vertices()) {
+      const Vec3 &was = before[v.idx()], &to = moved[v.idx()], &now = mesh.point(v);
+      if (now == to) {
+        ++kept;
+      } else if (now == was) {
+        ++back;
+      } else {
+        bool on_the_way = false;
+        for (double t : {0.5, 0.25, 0.125})
+          on_the_way = on_the_way || (now - (was + (to - was) * t)).norm() < 1e-12;
+        CHECK(on_the_way);
+        ++partly;
+      }
+    }
+    CHECK(kept > 0);  // not a plain undo: vertices whose edges stayed inside keep their move
+    CHECK(back + partly > 0);
+    if (halvings == 0) CHECK(partly == 0);
+    if (halvings == 3) CHECK(partly > 0);
   }
 }
 
