@@ -45,7 +45,9 @@ struct Seen {
 struct ReferenceSurface::Impl {
   std::vector<Vec3> points;
   /// What a query reads of a triangle, in one record (one or two cache lines instead of four arrays:
-  /// the candidate loop of closest_point visits ~180 triangles per query, scattered in memory).
+  /// the candidate loop of closest_point visits ~100 triangles per query, scattered in memory).
+  /// Measured alone: armadillo's queries 1.75 -> 1.57 us; small references, which stay in the
+  /// cache, gain nothing (cheese 2.85 -> 2.88, cow 1.19 -> 1.17).
   struct Triangle {
     Vec3 centre;                          ///< centroid
     double radius = 0;                    ///< largest distance centroid -> corner
