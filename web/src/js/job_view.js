@@ -27,6 +27,7 @@ export class JobView {
     this.source = null;
     this.retry = null;
     this.generation = 0;
+    this.refreshes = 0;
     const params = () => this.job?.params || {};
     this.charts = [
       new IterationChart($('chart-length'), [
@@ -108,9 +109,14 @@ export class JobView {
   }
 
   async refresh(generation, ended = false) {
+    // Refreshes overlap (a 'state' event each): an answer overtaken by a later request is dropped
+    // unless the job had ended by then, so an answer sent while the job was running cannot land
+    // after the one that says it succeeded (seen in the e2e test under load: 'running' shown last).
+    const request = ++this.refreshes;
     try {
       const job = await api.get_job(this.job.id);
       if (generation !== this.generation) return;
+      if (request !== this.refreshes && !FINAL.has(job.state)) return;
       this.set_job(job);
       if (ended || FINAL.has(job.state)) {
         this.add_rows(await api.get_stats(job.id));  // rows sent just before the end, if any raced
@@ -134,6 +140,8 @@ export class JobView {
   }
 
   set_job(job) {
+    // A job that ended stays ended: an older document of it (a slow answer) is not applied.
+    if (this.job && job.id === this.job.id && FINAL.has(this.job.state) && !FINAL.has(job.state)) return;
     this.job = job;
     this.render_head();
     this.render_downloads();
