@@ -221,6 +221,26 @@ TEST_CASE("convergence stops early unless all iterations are asked for", "[equal
   CHECK(r2.iterations_done == 12);
 }
 
+TEST_CASE("a strong simplification starts the cleanup only once its edge count settles", "[equalize]") {
+  // Mean edge 0.4 -> [1.2, 1.8]: the stellar operations collapse a large share of the edges per
+  // iteration for several iterations while the fraction inside stays low, which is no plateau. The
+  // first iteration with cleanup fixes is one where the edge count changed by at most 10 % over the
+  // three before it, or where the fraction inside had reached 97 % (the other trigger).
+  for (auto mesh : {test::make_icosphere(5, 10.0), test::make_torus(160, 64, 12.0, 4.0)}) {
+    test::scale_mean_edge(mesh, 0.4);
+    std::vector<IterationStats> rows;
+    equalize(mesh, table_4_2(100), [&](const IterationStats& s) { rows.push_back(s); });
+    std::size_t first = 0;
+    while (first < rows.size() && rows[first].cleanup_fixes == 0) ++first;
+    REQUIRE(first < rows.size());
+    INFO("first cleanup in iteration " << rows[first].iteration);
+    REQUIRE(first >= 4);  // the collapses took several iterations
+    const double now = static_cast<double>(rows[first - 1].edges), then = static_cast<double>(rows[first - 4].edges);
+    CHECK((std::abs(now - then) <= 0.10 * then || rows[first].inside_fraction >= 0.97));
+    CHECK(test::plain_inside_fraction(mesh, 1.2, 1.8) >= 0.99);
+  }
+}
+
 TEST_CASE("a stalled run returns the mesh with the fewest edges outside", "[equalize]") {
   // Tori whose tube (diameter 1.0 and 1.2) is too thin for every edge to reach [1.2, 1.8]: the count
   // of edges outside stops falling and wanders around its low.
