@@ -465,6 +465,10 @@ Result equalize(TriMesh& mesh, const Params& params, const OnIteration& on_itera
       row.cleanup_fixes += snapped;
       untangle_and_mend(mesh, *reference, params, neighbour_caches, row);
       if (row.cleanup_fixes != fixes_before) row = measured_row(mesh, params, row);
+      // The outcome describes the mesh returned: the untangling's cleanup can mend a stalled run's
+      // last edges (nefertiti's simplification), and its last round can leave an edge outside.
+      if (outcome == Outcome::Stalled || outcome == Outcome::Converged)
+        outcome = row.small + row.big == 0 ? Outcome::Converged : Outcome::Stalled;
     }
     row.seconds = restore ? best->row.seconds : seconds_since(iteration_start);
     result.iterations_done = row.iteration;

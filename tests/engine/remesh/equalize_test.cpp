@@ -42,7 +42,10 @@ IterationStats remesh_and_check(TriMesh& mesh, const Params& p) {
   const Topology before = topology(mesh);
   REQUIRE(find_self_intersections(mesh, 1).empty());
   IterationStats last;
-  equalize(mesh, p, [&](const IterationStats& s) { last = s; });
+  const Result result = equalize(mesh, p, [&](const IterationStats& s) { last = s; });
+  // Converged exactly when every edge of the returned mesh is inside (unless n ran out first).
+  if (result.outcome != Outcome::Completed)
+    CHECK((result.outcome == Outcome::Converged) == (test::plain_inside_fraction(mesh, p.e_min, p.e_max) == 1.0));
   CHECK(test::check_mesh_valid(mesh) == "");
   CHECK(topology(mesh) == before);
   CHECK(find_self_intersections(mesh, 1).empty());
