@@ -113,13 +113,13 @@ constexpr int kPlateauSpan = 3;
 constexpr double kPlateauGain = 0.002;
 constexpr double kPlateauShrink = 0.15;
 constexpr double kPlateauEdgeChange = 0.10;
-bool plateaued(const std::vector<double>& history, const std::vector<std::size_t>& edges) {
+bool plateaued(const std::vector<IterationStats>& history) {
   const std::size_t n = history.size();
   if (n <= kPlateauSpan) return false;
-  const double edges_now = static_cast<double>(edges[n - 1]);
-  const double edges_then = static_cast<double>(edges[n - 1 - kPlateauSpan]);
+  const IterationStats &last = history[n - 1], &first = history[n - 1 - kPlateauSpan];
+  const double edges_now = static_cast<double>(last.edges), edges_then = static_cast<double>(first.edges);
   if (std::abs(edges_now - edges_then) > kPlateauEdgeChange * edges_then) return false;
-  const double now = history[n - 1], then = history[n - 1 - kPlateauSpan];
+  const double now = last.inside_fraction, then = first.inside_fraction;
   return now - then < kPlateauGain || (1.0 - now) > (1.0 - kPlateauShrink) * (1.0 - then);
 }
 
@@ -297,8 +297,7 @@ Result equalize(TriMesh& mesh, const Params& params, const OnIteration& on_itera
   std::vector<NeighbourCache> neighbour_caches;  // per vertex, for the projection (projection.h)
 
   Result result;
-  std::vector<double> inside_history;      // inside_fraction after each iteration
-  std::vector<std::size_t> edges_history;  // the edge count after each iteration
+  std::vector<IterationStats> history;  // the row of each iteration (plateaued)
   bool cleanup_started = false;        // the full cleanup, once started, runs in every iteration
   int cleanup_from = 0;                // the iteration it started in (0: not yet)
   std::size_t fewest_outside = SIZE_MAX;  // fewest edges outside the interval since then, and when
@@ -380,7 +379,7 @@ Result equalize(TriMesh& mesh, const Params& params, const OnIteration& on_itera
     if (params.cleanup && !stop.stop_requested()) {
       const bool last = i == params.iterations;
       cleanup_started = cleanup_started || (!params.run_all_iterations &&
-                                            (2 * i > params.iterations || plateaued(inside_history, edges_history) ||
+                                            (2 * i > params.iterations || plateaued(history) ||
                                              inside_fraction(mesh, params, threads) >= kCleanupFrom));
       if (cleanup_started && cleanup_from == 0) cleanup_from = i;
       const bool full = last || cleanup_started;
@@ -444,7 +443,6 @@ Result equalize(TriMesh& mesh, const Params& params, const OnIteration& on_itera
           if (fixes(c) > 0) {
             count_cleanup(row, c);
             row = measured_row(mesh, params, row);
-            if (c.outside_after == 0 && outcome == Outcome::Stalled) outcome = Outcome::Converged;
           }
         }
       }
@@ -465,15 +463,15 @@ Result equalize(TriMesh& mesh, const Params& params, const OnIteration& on_itera
       row.cleanup_fixes += snapped;
       untangle_and_mend(mesh, *reference, params, neighbour_caches, row);
       if (row.cleanup_fixes != fixes_before) row = measured_row(mesh, params, row);
-      // The outcome describes the mesh returned: the untangling's cleanup can mend a stalled run's
-      // last edges (nefertiti's simplification), and its last round can leave an edge outside.
-      if (outcome == Outcome::Stalled || outcome == Outcome::Converged)
-        outcome = row.small + row.big == 0 ? Outcome::Converged : Outcome::Stalled;
     }
+    // The outcome of a run that stopped early describes the mesh returned, which this row does: the
+    // final cleanup or the untangling's can mend a stalled run's last edges (nefertiti's
+    // simplification), and the untangling's last round can leave an edge outside.
+    if (outcome == Outcome::Stalled || outcome == Outcome::Converged)
+      outcome = row.small + row.big == 0 ? Outcome::Converged : Outcome::Stalled;
     row.seconds = restore ? best->row.seconds : seconds_since(iteration_start);
     result.iterations_done = row.iteration;
-    inside_history.push_back(row.inside_fraction);
-    edges_history.push_back(row.edges);
+    history.push_back(row);
     // Rows of the polishing iterations wait until it is known whether they stand (rows after the
     // best mesh do not when it is restored).
     if (best && !ending) {
