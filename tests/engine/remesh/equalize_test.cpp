@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "remesh/equalize.h"
+#include "remesh/geometry.h"
 #include "remesh/self_intersections.h"
 #include "support/mesh_generators.h"
 #include "test_helpers.h"
@@ -241,6 +242,34 @@ TEST_CASE("a strong simplification starts the cleanup only once its edge count s
     const double now = static_cast<double>(rows[first - 1].edges), then = static_cast<double>(rows[first - 4].edges);
     CHECK((std::abs(now - then) <= 0.10 * then || rows[first].inside_fraction >= 0.97));
     CHECK(test::plain_inside_fraction(mesh, 1.2, 1.8) >= 0.99);
+  }
+}
+
+TEST_CASE("the returned mesh's normals are those of its faces", "[equalize]") {
+  // A converged run (the mesh of the last iteration) and a stalled one (the mesh of its low, rebuilt
+  // from a snapshot), refined and simplified.
+  struct Case {
+    TriMesh mesh;
+    Outcome outcome;
+  };
+  std::vector<Case> cases;
+  cases.push_back({test::make_icosphere(3, 10.0), Outcome::Converged});
+  cases.push_back({test::make_icosphere(5, 10.0), Outcome::Converged});
+  cases.push_back({test::make_torus(40, 12, 5.0, 0.6), Outcome::Stalled});
+  for (auto& [mesh, expected] : cases) {
+    const Result result = equalize(mesh, table_4_2(100));
+    REQUIRE(result.outcome == expected);
+    REQUIRE(mesh.has_face_normals());
+    REQUIRE(mesh.has_vertex_normals());
+    for (auto f : mesh.faces()) {
+      const Vec3 n = geom::face_normal(mesh, f).normalized();
+      CHECK(mesh.normal(f).norm() == Approx(1.0).epsilon(1e-9));
+      CHECK((mesh.normal(f) | n) > 1.0 - 1e-9);
+    }
+    for (auto v : mesh.vertices()) {
+      CHECK(mesh.normal(v).norm() == Approx(1.0).epsilon(1e-9));
+      CHECK((mesh.normal(v) | geom::vertex_normal(mesh, v)) > 0.9);
+    }
   }
 }
 
