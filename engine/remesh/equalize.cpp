@@ -275,6 +275,12 @@ void release_normals(TriMesh& mesh) {
   mesh.release_face_normals();
 }
 
+/// `mesh` becomes the snapshot's mesh again, without the normal attributes (release_normals).
+void restore_snapshot(TriMesh& mesh, const MeshSnapshot& snapshot) {
+  mesh = snapshot.rebuild();
+  release_normals(mesh);
+}
+
 }  // namespace
 
 const char* outcome_name(Outcome o) {
@@ -446,7 +452,7 @@ Result equalize(TriMesh& mesh, const Params& params, const OnIteration& on_itera
       if (!best && (outcome == Outcome::Stalled || i == params.iterations)) {
         const std::size_t low = fewest ? fewest->row.small + fewest->row.big : SIZE_MAX;
         if (low < outside || (low == outside && fewest->row.regular_percent > row.regular_percent)) {
-          mesh = fewest->mesh.rebuild();
+          restore_snapshot(mesh, fewest->mesh);
           row = measured_row(mesh, params, row);
         }
         if (!stop.stop_requested()) {
@@ -461,8 +467,7 @@ Result equalize(TriMesh& mesh, const Params& params, const OnIteration& on_itera
       outcome = Outcome::Converged;
     }
     if (restore) {
-      mesh = best->mesh.rebuild();
-      release_normals(mesh);
+      restore_snapshot(mesh, best->mesh);
       row = best->row;
       held.clear();
     }
