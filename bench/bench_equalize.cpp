@@ -190,6 +190,16 @@ double print_quality(const char* who, const TriMesh& input, const TriMesh& outpu
   return 100 * h;
 }
 
+/// Where the time of a run went (Result::phases), in seconds; "other" is the rest (statistics rows,
+/// snapshots, the thin-part count).
+void print_phases(const Result& r) {
+  const PhaseSeconds& t = r.phases;
+  std::printf("ours : seconds by step: stellar %.3f, flips %.3f, filter %.3f, projection %.3f, guards %.3f, "
+              "cleanup %.3f, snap %.3f, untangle %.3f, setup %.3f, other %.3f\n",
+              t.stellar, t.flips, t.filter, t.projection, t.guards, t.cleanup, t.snap, t.untangle, t.setup,
+              std::max(0.0, r.seconds - t.sum()));
+}
+
 /// Remeshes the mesh in file `scaled` to [e_min, e_max] in a forked child, writing `out`; prints the
 /// statistics rows when `rows`.
 ChildResult run_ours(const std::string& scaled, const std::string& out_file, double e_min, double e_max,
@@ -209,6 +219,7 @@ ChildResult run_ours(const std::string& scaled, const std::string& out_file, dou
     });
     if (rows && last.iteration % o.rows_every != 0 && last.iteration != 1) print_row(last);
     if (rows && last.cleanup_fixes) std::printf("  (last row includes %zu interval-cleanup fixes)\n", last.cleanup_fixes);
+    if (rows) print_phases(r);
     bench::write_off(mesh, out);
     std::ofstream(out + ".time") << r.seconds << ' ' << r.iterations_done << ' ' << outcome_name(r.outcome) << '\n';
   });

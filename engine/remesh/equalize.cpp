@@ -36,6 +36,30 @@ double seconds_since(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
 }
 
+/// Adds the wall time from its construction (or switch_to) to stop() or its destruction to a
+/// PhaseSeconds field.
+class PhaseTimer {
+ public:
+  explicit PhaseTimer(double& total) : total_(&total) {}
+  ~PhaseTimer() { stop(); }
+  PhaseTimer(const PhaseTimer&) = delete;
+  PhaseTimer& operator=(const PhaseTimer&) = delete;
+  /// Ends the phase timed so far and times `next` from now.
+  void switch_to(double& next) {
+    stop();
+    total_ = &next;
+    start_ = Clock::now();
+  }
+  void stop() {
+    if (total_) *total_ += seconds_since(start_);
+    total_ = nullptr;
+  }
+
+ private:
+  double* total_;
+  Clock::time_point start_ = Clock::now();
+};
+
 /// The half-width of the main phase's band, m_i +- sigma (the priority list and the stellar
 /// operations, Alg. 2 and 3): (e_max - e_min) / 2 as in ALGORITHM.md, but never less than
 /// kMinBand m. Not in the thesis, whose setup is [1.2, 1.8], +-20 % of m, where the two agree. A
@@ -222,10 +246,11 @@ std::vector<CrossingKey> crossing_keys(const TriMesh& mesh, const std::vector<st
 }
 
 void untangle_and_mend(TriMesh& mesh, const ReferenceSurface& reference, const Params& params,
-                       std::vector<NeighbourCache>& caches, IterationStats& row) {
+                       std::vector<NeighbourCache>& caches, IterationStats& row, PhaseSeconds& phases) {
   // The row describes the mesh before the feature snap, which takes no edge out of the interval.
   const std::size_t outside_before = row.small + row.big;
   for (int round = 1; round <= kUntangleRounds; ++round) {
+    PhaseTimer timer(phases.untangle);
     const UntangleCounts u = untangle(mesh, reference, params.e_min, params.e_max, params.threads);
     row.cleanup_fixes += u.moved;
     if (u.moved == 0 || round == kUntangleRounds) return;
@@ -234,7 +259,9 @@ void untangle_and_mend(TriMesh& mesh, const ReferenceSurface& reference, const P
     const IterationStats now = measure(mesh, params.e_min, params.e_max, params.threads);
     if (now.small + now.big <= outside_before) return;
     const std::vector<CrossingKey> left = crossing_keys(mesh, u.left);
+    timer.switch_to(phases.cleanup);
     const CleanupCounts c = run_cleanup(mesh, reference, params, caches, /*final=*/true);
+    timer.switch_to(phases.untangle);
     count_cleanup(row, c);
     // Again only if the cleanup made faces cross that did not before (the pairs it left alone
     // keep their corners; its edits renumber the faces).
@@ -307,13 +334,16 @@ Result equalize(TriMesh& mesh, const Params& params, const OnIteration& on_itera
   const unsigned threads = params.threads;
   const double m = 0.5 * (params.e_min + params.e_max);
   const double sigma = main_phase_sigma(params);
+  Result result;
+  PhaseSeconds& phases = result.phases;
+  PhaseTimer setup_timer(phases.setup);
   mesh.garbage_collection();
   release_normals(mesh);
   auto reference = std::make_unique<ReferenceSurface>(mesh);
   auto features = std::make_unique<FeatureSnap>(mesh, params.e_min);
+  setup_timer.stop();
   std::vector<NeighbourCache> neighbour_caches;  // per vertex, for the projection (projection.h)
 
-  Result result;
   std::vector<IterationStats> history;  // the row of each iteration (plateaued)
   bool cleanup_started = false;        // the full cleanup, once started, runs in every iteration
   int cleanup_from = 0;                // the iteration it started in (0: not yet)
@@ -341,28 +371,35 @@ Result equalize(TriMesh& mesh, const Params& params, const OnIteration& on_itera
     const auto iteration_start = Clock::now();
     IterationStats counters;
     if (params.relax_every > 0 && i % params.relax_every == 0) {
+      const PhaseTimer timer(phases.setup);
       reference = std::make_unique<ReferenceSurface>(mesh);
       features = std::make_unique<FeatureSnap>(mesh, params.e_min);
     }
 
     // Algorithms 2 and 3: stellar operations on the priority list.
-    const double m_i = std::min(2.0 * mean_edge_length(mesh, threads), m);
-    const std::vector<unsigned> list = make_priority_list(mesh, m_i, sigma, threads);
-    const StellarCounts stellar = stellar_operations(mesh, list, m_i, sigma);
-    mesh.garbage_collection();
-    counters.splits = stellar.splits;
-    counters.collapses = stellar.collapses;
+    {
+      const PhaseTimer timer(phases.stellar);
+      const double m_i = std::min(2.0 * mean_edge_length(mesh, threads), m);
+      const std::vector<unsigned> list = make_priority_list(mesh, m_i, sigma, threads);
+      const StellarCounts stellar = stellar_operations(mesh, list, m_i, sigma);
+      mesh.garbage_collection();
+      counters.splits = stellar.splits;
+      counters.collapses = stellar.collapses;
+    }
     if (stop.stop_requested()) {
       result.outcome = Outcome::Cancelled;
       break;
     }
 
     // Algorithm 4: valence-improving flips.
-    counters.flips = valence_flips(mesh, params.flip_factor, kFlipSweeps, threads);
-    // Not in the thesis: the look-ahead flips that let 5-7 pairs cancel (regularize.h).
-    if (params.cleanup) {
-      const RegularizeCounts r = regularize(mesh, params.flip_factor, kRegularizeSweeps, threads);
-      counters.flips += r.single + 2 * r.pairs;
+    {
+      const PhaseTimer timer(phases.flips);
+      counters.flips = valence_flips(mesh, params.flip_factor, kFlipSweeps, threads);
+      // Not in the thesis: the look-ahead flips that let 5-7 pairs cancel (regularize.h).
+      if (params.cleanup) {
+        const RegularizeCounts r = regularize(mesh, params.flip_factor, kRegularizeSweeps, threads);
+        counters.flips += r.single + 2 * r.pairs;
+      }
     }
     if (stop.stop_requested()) {
       result.outcome = Outcome::Cancelled;
@@ -370,14 +407,18 @@ Result equalize(TriMesh& mesh, const Params& params, const OnIteration& on_itera
     }
 
     // Algorithm 5 then 6: filter and projection, guarded against folds as one move.
+    PhaseTimer move_timer(phases.filter);
     const std::vector<Vec3> before = snapshot_points(mesh);
     low_pass_filter(mesh, params.rings, threads);
     if (stop.stop_requested()) {
+      move_timer.switch_to(phases.guards);
       undo_folds(mesh, before, threads);
       result.outcome = Outcome::Cancelled;
       break;
     }
+    move_timer.switch_to(phases.projection);
     counters.max_projection_distance = project_onto_reference(mesh, *reference, threads, &neighbour_caches);
+    move_timer.switch_to(phases.guards);
     undo_folds(mesh, before, threads);
     // Not in the thesis: once the interval cleanup has run for kSteadyAfter iterations, the filter
     // and projection may not take an edge out of the interval (nor fold a face, as before), while
@@ -386,6 +427,7 @@ Result equalize(TriMesh& mesh, const Params& params, const OnIteration& on_itera
         i - 1 - fewest_at < kExploreAfter)
       while (undo_interval_breaks(mesh, before, params.e_min, params.e_max) > 0 && undo_folds(mesh, before, threads) > 0) {
       }
+    move_timer.stop();
 
     // Not in the thesis: the post-process its conclusion asks for (interval_cleanup.h). It runs in
     // the last iteration, and in every iteration once at least kCleanupFrom of the edges are inside,
@@ -401,6 +443,7 @@ Result equalize(TriMesh& mesh, const Params& params, const OnIteration& on_itera
       if (cleanup_started && cleanup_from == 0) cleanup_from = i;
       const bool full = last || cleanup_started;
       if (full || reference->has_boundary()) {
+        const PhaseTimer timer(phases.cleanup);
         count_cleanup(counters, run_cleanup(mesh, *reference, params, neighbour_caches, /*final=*/false,
                                             /*boundary_only=*/!full));
       }
@@ -456,7 +499,9 @@ Result equalize(TriMesh& mesh, const Params& params, const OnIteration& on_itera
           row = measured_row(mesh, params, row);
         }
         if (!stop.stop_requested()) {
+          PhaseTimer timer(phases.cleanup);
           const CleanupCounts c = run_cleanup(mesh, *reference, params, neighbour_caches, /*final=*/true);
+          timer.stop();
           if (fixes(c) > 0) {
             count_cleanup(row, c);
             row = measured_row(mesh, params, row);
@@ -475,10 +520,12 @@ Result equalize(TriMesh& mesh, const Params& params, const OnIteration& on_itera
     // Not in the thesis: before the mesh is returned, the reference vertices it cuts off (tips,
     // creases) are put back on it (feature_snap.h); no edge leaves the interval.
     if (ending && params.cleanup && !stop.stop_requested()) {
+      PhaseTimer timer(phases.snap);
       const std::size_t snapped = features->apply(mesh, *reference, params.e_min, params.e_max, threads);
+      timer.stop();
       const std::size_t fixes_before = row.cleanup_fixes;
       row.cleanup_fixes += snapped;
-      untangle_and_mend(mesh, *reference, params, neighbour_caches, row);
+      untangle_and_mend(mesh, *reference, params, neighbour_caches, row, phases);
       if (row.cleanup_fixes != fixes_before) row = measured_row(mesh, params, row);
     }
     // The outcome of a run that stopped early describes the mesh returned, which this row does: the

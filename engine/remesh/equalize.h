@@ -51,10 +51,27 @@ enum class Outcome { Completed, Converged, Stalled, Cancelled };
 /// "completed", "converged", "stalled" or "cancelled" (the API, CLI and benchmark print these).
 const char* outcome_name(Outcome o);
 
+/// Wall seconds a run spent in each of its steps, summed over its iterations: where the time goes
+/// (the benchmark prints them). Statistics rows, snapshots of the best mesh so far and the thin-part
+/// count make up the rest of Result::seconds.
+struct PhaseSeconds {
+  double stellar = 0;     ///< priority list, stellar operations, garbage collection (Alg. 2, 3)
+  double flips = 0;       ///< valence flips (Alg. 4) and look-ahead flips (regularize.h)
+  double filter = 0;      ///< low-pass filter (Alg. 5)
+  double projection = 0;  ///< projection onto the reference (Alg. 6)
+  double guards = 0;      ///< undoing folds and interval breaks of the filter and projection (fold_guard.h)
+  double cleanup = 0;     ///< interval cleanups: the iterations', the final one, the untangling's mends
+  double snap = 0;        ///< feature snap (feature_snap.h)
+  double untangle = 0;    ///< moving crossing faces apart (untangle.h), its mends not included
+  double setup = 0;       ///< reference surface, its kd-tree and feature points (and again at each `pr`)
+  double sum() const { return stellar + flips + filter + projection + guards + cleanup + snap + untangle + setup; }
+};
+
 struct Result {
   Outcome outcome = Outcome::Completed;
   int iterations_done = 0;
   double seconds = 0;
+  PhaseSeconds phases;  ///< how `seconds` divides between the steps
   /// The returned mesh's edges outside the interval, and how many of them lie where the input is
   /// too thin for any edge there to be inside (thin_parts.h).
   ThinParts thin;

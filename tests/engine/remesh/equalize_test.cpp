@@ -50,6 +50,17 @@ IterationStats remesh_and_check(TriMesh& mesh, const Params& p) {
   CHECK(test::check_mesh_valid(mesh) == "");
   CHECK(topology(mesh) == before);
   CHECK(find_self_intersections(mesh, 1).empty());
+  // The steps' times (Result::phases) do not overlap: they add up to at most the run's time, and
+  // every step of Algorithm 1 took some.
+  const PhaseSeconds& t = result.phases;
+  for (double x : {t.stellar, t.flips, t.filter, t.projection, t.guards, t.cleanup, t.snap, t.untangle, t.setup})
+    CHECK(x >= 0);
+  CHECK(t.sum() <= result.seconds + 1e-9);
+  CHECK(t.stellar > 0);
+  CHECK(t.flips > 0);
+  CHECK(t.filter > 0);
+  CHECK(t.projection > 0);
+  CHECK(t.setup > 0);
   return last;
 }
 
