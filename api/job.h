@@ -49,6 +49,10 @@ struct JobRecord {
   /// Of the result: its edges outside the interval and those in parts of the input too thin for
   /// any edge there to be inside (remesh/thin_parts.h); nullopt until the job succeeded.
   std::optional<ThinParts> thin_parts;
+  /// Of the run that succeeded: where its time went, step by step (Result::phases), and the
+  /// remeshing call's own seconds (Result::seconds); nullopt until the job succeeded.
+  std::optional<PhaseSeconds> seconds_by_step;
+  std::optional<double> remesh_seconds;
   std::optional<std::string> error;
 };
 

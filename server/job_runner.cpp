@@ -37,6 +37,8 @@ RunOutput run_job(const remesh::api::JobRecord& job, std::string_view upload, un
   out.outcome = result.outcome;
   out.iterations_done = result.iterations_done;
   out.thin = result.thin;
+  out.phases = result.phases;
+  out.seconds = result.seconds;
   if (result.outcome == remesh::Outcome::Cancelled) return out;
 
   mesh.garbage_collection();

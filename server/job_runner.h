@@ -17,6 +17,8 @@ struct RunOutput {
   remesh::Outcome outcome = remesh::Outcome::Completed;
   int iterations_done = 0;
   remesh::ThinParts thin;  ///< Result::thin
+  remesh::PhaseSeconds phases;  ///< Result::phases
+  double seconds = 0;           ///< Result::seconds
   /// File name ("remeshed.obj", "dual.glb", ...) -> bytes; empty when cancelled.
   std::map<std::string, std::string> files;
 };

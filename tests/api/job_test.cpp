@@ -53,6 +53,7 @@ TEST_CASE("job document: fields, links only when succeeded, round trip", "[api][
   CHECK(doc["latest"].is_null());
   CHECK(doc["outcome"].is_null());
   CHECK(doc["thin_parts"].is_null());
+  CHECK(doc["seconds_by_step"].is_null());
   CHECK(doc["error"].is_null());
   CHECK(doc["params"]["emin"] == 0.5);
   CHECK(doc["params"]["weld"] == false);
@@ -72,7 +73,17 @@ TEST_CASE("job document: fields, links only when succeeded, round trip", "[api][
   r.latest = last;
   r.iteration = 9;
   r.thin_parts = ThinParts{12, 7, 1.25};
+  PhaseSeconds phases;
+  phases.stellar = 0.5, phases.projection = 0.25, phases.untangle = 0.125;
+  r.seconds_by_step = phases;
+  r.remesh_seconds = 1.0;
   doc = job_to_json(r, "/api/v1", r.created_at + 100);
+  CHECK(doc["seconds_by_step"]["stellar"] == 0.5);
+  CHECK(doc["seconds_by_step"]["projection"] == 0.25);
+  CHECK(doc["seconds_by_step"]["untangle"] == 0.125);
+  CHECK(doc["seconds_by_step"]["cleanup"] == 0.0);
+  CHECK(doc["seconds_by_step"]["other"] == 0.125);  // 1 - (0.5 + 0.25 + 0.125)
+  CHECK(doc["seconds_by_step"]["total"] == 1.0);
   CHECK(doc["thin_parts"]["outside"] == 12);
   CHECK(doc["thin_parts"]["in_thin_parts"] == 7);
   CHECK(doc["thin_parts"]["limit"] == 1.25);
@@ -94,10 +105,17 @@ TEST_CASE("job document: fields, links only when succeeded, round trip", "[api][
   CHECK(back.thin_parts->outside == 12);
   CHECK(back.thin_parts->in_thin_parts == 7);
   CHECK(back.thin_parts->limit == 1.25);
-  // A document written before the field existed still reads.
+  REQUIRE(back.seconds_by_step);
+  CHECK(back.seconds_by_step->stellar == 0.5);
+  CHECK(back.seconds_by_step->untangle == 0.125);
+  CHECK(back.seconds_by_step->sum() == 0.875);
+  CHECK(back.remesh_seconds == std::optional<double>(1.0));
+  // A document written before the fields existed still reads.
   json old = doc;
   old.erase("thin_parts");
+  old.erase("seconds_by_step");
   CHECK_FALSE(job_from_json(old).thin_parts);
+  CHECK_FALSE(job_from_json(old).seconds_by_step);
 
   json broken = doc;
   broken["state"] = "sleeping";

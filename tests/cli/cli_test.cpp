@@ -3,11 +3,13 @@
 
 #include <catch2/catch.hpp>
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include "run_process.h"
 #include "support/mesh_generators.h"
@@ -312,6 +314,34 @@ TEST_CASE("the summary says how many edges outside lie in parts too thin for the
   REQUIRE(s.exit_code == 0);
   CHECK(s.out.find("100.000 %") != std::string::npos);
   CHECK(s.out.find("in thin parts") == std::string::npos);
+}
+
+TEST_CASE("the summary says where the time went, step by step, adding up to the run's seconds", "[cli]") {
+  TempDir dir;
+  write_obj(remesh::test::make_icosphere(3, 4.0), dir.file("sphere.obj"));
+  const ProcessResult r = remesh_cli({dir.file("sphere.obj"), dir.file("out.obj"), "--emin", "1.2", "--emax", "1.8"});
+  INFO(r.out << r.err);
+  REQUIRE(r.exit_code == 0);
+  const auto outcome = r.out.find(" iterations, ");
+  REQUIRE(outcome != std::string::npos);
+  const double total = std::stod(r.out.substr(outcome + std::string(" iterations, ").size()));
+  const auto at = r.out.find("seconds by step:");
+  REQUIRE(at != std::string::npos);
+  // "stellar 0.012, flips 0.010, ..., other 0.001"
+  std::istringstream line(r.out.substr(at + std::string("seconds by step:").size(), r.out.find('\n', at) - at));
+  std::vector<std::string> names;
+  double sum = 0;
+  std::string name, value;
+  while (line >> name >> value) {
+    names.push_back(name);
+    const double seconds = std::stod(value);
+    CHECK(seconds >= 0);
+    sum += seconds;
+  }
+  CHECK(names == std::vector<std::string>{"stellar", "flips", "filter", "projection", "guards", "cleanup", "snap",
+                                          "untangle", "setup", "other"});
+  // Ten figures rounded to 0.001 s against the total rounded to 0.01 s.
+  CHECK(std::abs(sum - total) <= 0.011);
 }
 
 TEST_CASE("a job over --max-faces is refused with exit 3", "[cli]") {

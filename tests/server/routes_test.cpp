@@ -87,6 +87,18 @@ TEST_CASE("remeshd: submit raw and multipart, follow, download, list, delete", "
   CHECK(done["thin_parts"]["outside"] == done["latest"]["small"].get<int>() + done["latest"]["big"].get<int>());
   CHECK(done["thin_parts"]["in_thin_parts"] == 0);
   CHECK(done["thin_parts"]["limit"].get<double>() == Approx(0.4 / std::sqrt(3.0)));
+  // Where the time went: every step of Algorithm 1 took some, none negative, the remeshing call
+  // within the job's run, and the steps plus the rest add up to it.
+  const json& steps = done["seconds_by_step"];
+  for (const char* step : {"stellar", "flips", "filter", "projection", "setup"}) CHECK(steps[step].get<double>() > 0);
+  double sum = 0;
+  for (const auto& [name, seconds] : steps.items()) {
+    INFO(name);
+    CHECK(seconds.get<double>() >= 0);
+    if (name != "total") sum += seconds.get<double>();
+  }
+  CHECK(sum == Approx(steps["total"].get<double>()));
+  CHECK(steps["total"].get<double>() <= done["timings"]["run_seconds"].get<double>());
   REQUIRE(done["links"].contains("results"));
   for (const auto& [kind, formats] : done["links"]["results"].items())
     for (const auto& [fmt, url] : formats.items()) {
