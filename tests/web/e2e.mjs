@@ -110,6 +110,9 @@ async function main() {
   const streamed = await page.evaluate(() => window.__remeshd.view.streamed);
   check(streamed === rows.length, `every row arrived live over the event stream (${streamed} of ${rows.length})`);
   check(await wait_state(base, blocker, ['cancelled']), 'the API job ended cancelled');
+  await page.waitForFunction(() => /^seconds by step: stellar /.test(document.getElementById('progress-text').title), null, { timeout: 5000 }).catch(() => {});
+  const steps_title = await page.getAttribute('#progress-text', 'title');
+  check(/^seconds by step: stellar [\d.]+, flips [\d.]+, .*total [\d.]+$/.test(steps_title || ''), `time by step shown once succeeded (${steps_title})`);
   const summary_text = await page.textContent('#summary');
   check(/server summary/.test(summary_text) && /genus/.test(summary_text), 'server summary with genus replaces the local one');
 

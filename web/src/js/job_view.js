@@ -14,6 +14,10 @@ const TABLE = [
   ['inside_fraction', (v) => fixed(100 * v, 1)], ['splits', int], ['collapses', int], ['flips', int],
   ['seconds', (v) => fixed(v, 3)], ['max_projection_distance', num]];
 
+/// The steps of seconds_by_step in the order of a run (the JSON object's keys come sorted).
+const STEPS = ['stellar', 'flips', 'filter', 'projection', 'guards', 'cleanup', 'snap', 'untangle', 'setup', 'other',
+  'total'];
+
 function int(v) { return Number.isFinite(v) ? v.toLocaleString('en-US') : '–'; }
 function num(v) { return Number.isFinite(v) ? String(+v.toPrecision(5)) : '–'; }
 function fixed(v, d) { return Number.isFinite(v) ? v.toFixed(d) : '–'; }
@@ -196,6 +200,11 @@ export class JobView {
     const secs = this.rows.reduce((s, r) => s + (r.seconds || 0), 0);
     if (secs) text += ` · ${secs.toFixed(1)} s`;
     $('progress-text').textContent = text;
+    // Where the time went, once succeeded (seconds_by_step), as the line's tooltip, in the run's order.
+    const steps = job.seconds_by_step;
+    $('progress-text').title = steps
+      ? `seconds by step: ${STEPS.filter((k) => k in steps).map((k) => `${k} ${Number(steps[k]).toFixed(3)}`).join(', ')}`
+      : '';
     document.title = `${FINAL.has(job.state) ? job.state : `${done}/${total}`} · ${job.input?.filename || 'job'} · remeshd`;
     $('cancel').disabled = !(job.state === 'queued' || job.state === 'running');
     if (job.error) this.show_error(typeof job.error === 'string' ? job.error : job.error.detail || JSON.stringify(job.error));
