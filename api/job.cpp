@@ -6,7 +6,6 @@
 #include <ctime>
 #include <random>
 #include <stdexcept>
-#include <utility>
 
 #include "json_codec.h"
 
@@ -46,27 +45,20 @@ json format_links(const std::string& base, const char* mesh, const std::vector<s
   return links;
 }
 
-/// The steps of PhaseSeconds by their JSON names, in the order of a run.
-constexpr std::pair<const char*, double PhaseSeconds::*> kSteps[] = {
-    {"stellar", &PhaseSeconds::stellar},   {"flips", &PhaseSeconds::flips},
-    {"filter", &PhaseSeconds::filter},     {"projection", &PhaseSeconds::projection},
-    {"guards", &PhaseSeconds::guards},     {"cleanup", &PhaseSeconds::cleanup},
-    {"snap", &PhaseSeconds::snap},         {"untangle", &PhaseSeconds::untangle},
-    {"setup", &PhaseSeconds::setup}};
-
-/// {stellar, ..., setup, other, total}: other = total minus the steps (statistics rows, snapshots).
-json phases_to_json(const PhaseSeconds& p, double total) {
+/// {stellar, ..., setup, other, total} (kPhaseFields): other = total minus the steps.
+json step_seconds_to_json(const JobRecord::StepSeconds& s) {
   json j = json::object();
-  for (const auto& [name, field] : kSteps) j[name] = p.*field;
-  j["other"] = std::max(0.0, total - p.sum());
-  j["total"] = total;
+  for (const PhaseField& f : kPhaseFields) j[f.name] = s.steps.*f.seconds;
+  j["other"] = other_seconds(s.steps, s.total);
+  j["total"] = s.total;
   return j;
 }
 
-PhaseSeconds phases_from_json(const json& j) {
-  PhaseSeconds p;
-  for (const auto& [name, field] : kSteps) p.*field = j.at(name).get<double>();
-  return p;
+JobRecord::StepSeconds step_seconds_from_json(const json& j) {
+  JobRecord::StepSeconds s;
+  for (const PhaseField& f : kPhaseFields) s.steps.*f.seconds = j.at(f.name).get<double>();
+  s.total = j.at("total").get<double>();
+  return s;
 }
 
 }  // namespace
@@ -149,8 +141,7 @@ json job_to_json(const JobRecord& job, std::string_view prefix, double now) {
                                            {"in_thin_parts", job.thin_parts->in_thin_parts},
                                            {"limit", job.thin_parts->limit}}
                                      : json(nullptr)},
-      {"seconds_by_step", job.seconds_by_step ? phases_to_json(*job.seconds_by_step, job.remesh_seconds.value_or(0))
-                                              : json(nullptr)},
+      {"seconds_by_step", job.seconds_by_step ? step_seconds_to_json(*job.seconds_by_step) : json(nullptr)},
       {"error", job.error ? json(*job.error) : json(nullptr)},
       {"timings",
        {{"queued_seconds", std::max(0.0, queued_end - job.created_at)},
@@ -187,10 +178,8 @@ JobRecord job_from_json(const json& j) {
     if (const auto t = j.find("thin_parts"); t != j.end() && !t->is_null())
       job.thin_parts = ThinParts{t->at("outside").get<std::size_t>(), t->at("in_thin_parts").get<std::size_t>(),
                                  t->at("limit").get<double>()};
-    if (const auto t = j.find("seconds_by_step"); t != j.end() && !t->is_null()) {
-      job.seconds_by_step = phases_from_json(*t);
-      job.remesh_seconds = t->at("total").get<double>();
-    }
+    if (const auto t = j.find("seconds_by_step"); t != j.end() && !t->is_null())
+      job.seconds_by_step = step_seconds_from_json(*t);
     if (!j.at("error").is_null()) job.error = j.at("error").get<std::string>();
     return job;
   } catch (const json::exception& e) {

@@ -51,8 +51,11 @@ struct JobRecord {
   std::optional<ThinParts> thin_parts;
   /// Of the run that succeeded: where its time went, step by step (Result::phases), and the
   /// remeshing call's own seconds (Result::seconds); nullopt until the job succeeded.
-  std::optional<PhaseSeconds> seconds_by_step;
-  std::optional<double> remesh_seconds;
+  struct StepSeconds {
+    PhaseSeconds steps;
+    double total = 0;
+  };
+  std::optional<StepSeconds> seconds_by_step;
   std::optional<std::string> error;
 };
 

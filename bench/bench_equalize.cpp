@@ -197,11 +197,7 @@ double print_quality(const char* who, const TriMesh& input, const TriMesh& outpu
 /// Where the time of a run went (Result::phases), in seconds; "other" is the rest (statistics rows,
 /// snapshots, the thin-part count).
 void print_phases(const Result& r) {
-  const PhaseSeconds& t = r.phases;
-  std::printf("ours : seconds by step: stellar %.3f, flips %.3f, filter %.3f, projection %.3f, guards %.3f, "
-              "cleanup %.3f, snap %.3f, untangle %.3f, setup %.3f, other %.3f\n",
-              t.stellar, t.flips, t.filter, t.projection, t.guards, t.cleanup, t.snap, t.untangle, t.setup,
-              std::max(0.0, r.seconds - t.sum()));
+  std::printf("ours : seconds by step: %s\n", describe_phases(r.phases, r.seconds).c_str());
 }
 
 /// Remeshes the mesh in file `scaled` to [e_min, e_max] in a forked child, writing `out`; prints the
@@ -290,18 +286,19 @@ void run_matched(const std::string& name, const std::string& scaled, const TriMe
   double cgal_mean = measure(cgal, kEmin, kEmax, o.threads).mean;
   const std::string out = (dir / (name + "_cgal_matched.off")).string();
   ChildResult r;
+  TriMesh matched;
   for (int step = 0; step < 2; ++step) {
     if (!(cgal_mean > 0)) break;
     target *= ours_mean / cgal_mean;
     r = run_cgal(scaled, out, target);
     if (!r.ok) break;
-    cgal_mean = measure(bench::load_mesh(out), kEmin, kEmax, o.threads).mean;
+    matched = bench::load_mesh(out);
+    cgal_mean = measure(matched, kEmin, kEmax, o.threads).mean;
   }
   if (!r.ok) {
     std::printf("cgal at our density: FAILED\n");
     return;
   }
-  const TriMesh matched = bench::load_mesh(out);
   std::printf("cgal at our density: target %.4f (mean edge ours %.4f, cgal %.4f)\n", target, ours_mean, cgal_mean);
   const double h = print_quality("cgal=", input, matched, topo_in, crossings_in, r, o);
   std::printf("ratio ours/cgal at our density: Hausdorff %.2fx, vertices %.3fx, time %.2fx\n", ours_h / h,

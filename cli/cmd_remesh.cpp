@@ -120,11 +120,7 @@ void print_final(const TriMesh& mesh, const Job& job, const Result& result) {
   std::printf("  outcome:              %s after %d iteration%s, %.2f s\n", outcome_name(result.outcome),
               result.iterations_done, result.iterations_done == 1 ? "" : "s", result.seconds);
   // Where the time went (Result::phases); "other" is the rest: statistics rows, snapshots.
-  const PhaseSeconds& t = result.phases;
-  std::printf("  seconds by step:      stellar %.3f, flips %.3f, filter %.3f, projection %.3f, guards %.3f, "
-              "cleanup %.3f, snap %.3f, untangle %.3f, setup %.3f, other %.3f\n",
-              t.stellar, t.flips, t.filter, t.projection, t.guards, t.cleanup, t.snap, t.untangle, t.setup,
-              std::max(0.0, result.seconds - t.sum()));
+  std::printf("  seconds by step:      %s\n", describe_phases(result.phases, result.seconds).c_str());
   std::fflush(stdout);
 }
 

@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <memory>
 #include <optional>
 #include <string>
@@ -309,6 +310,17 @@ void restore_snapshot(TriMesh& mesh, const MeshSnapshot& snapshot) {
 }
 
 }  // namespace
+
+std::string describe_phases(const PhaseSeconds& phases, double seconds) {
+  std::string text;
+  char buffer[64];
+  for (const PhaseField& f : kPhaseFields) {
+    std::snprintf(buffer, sizeof buffer, "%s %.3f, ", f.name, phases.*f.seconds);
+    text += buffer;
+  }
+  std::snprintf(buffer, sizeof buffer, "other %.3f", other_seconds(phases, seconds));
+  return text + buffer;
+}
 
 const char* outcome_name(Outcome o) {
   switch (o) {

@@ -11,9 +11,11 @@
 ///     projection onto the reference surface       (Algorithm 6)
 ///     report the statistics row; stop if cancelled or converged
 
+#include <algorithm>
 #include <cstddef>
 #include <functional>
 #include <stop_token>
+#include <string>
 
 #include "core/mesh.h"
 #include "remesh/params.h"
@@ -52,8 +54,8 @@ enum class Outcome { Completed, Converged, Stalled, Cancelled };
 const char* outcome_name(Outcome o);
 
 /// Wall seconds a run spent in each of its steps, summed over its iterations: where the time goes
-/// (the benchmark prints them). Statistics rows, snapshots of the best mesh so far and the thin-part
-/// count make up the rest of Result::seconds.
+/// (the benchmark, the CLI and the job document show them). Statistics rows, snapshots of the best
+/// mesh so far and the thin-part count make up the rest of Result::seconds.
 struct PhaseSeconds {
   double stellar = 0;     ///< priority list, stellar operations, garbage collection (Alg. 2, 3)
   double flips = 0;       ///< valence flips (Alg. 4) and look-ahead flips (regularize.h)
@@ -66,6 +68,24 @@ struct PhaseSeconds {
   double setup = 0;       ///< reference surface, its kd-tree and feature points (and again at each `pr`)
   double sum() const { return stellar + flips + filter + projection + guards + cleanup + snap + untangle + setup; }
 };
+
+/// The steps of PhaseSeconds by name, in the order of a run (the CLI, the API and the benchmark
+/// name them so).
+struct PhaseField {
+  const char* name;
+  double PhaseSeconds::*seconds;
+};
+inline constexpr PhaseField kPhaseFields[] = {
+    {"stellar", &PhaseSeconds::stellar}, {"flips", &PhaseSeconds::flips},   {"filter", &PhaseSeconds::filter},
+    {"projection", &PhaseSeconds::projection}, {"guards", &PhaseSeconds::guards}, {"cleanup", &PhaseSeconds::cleanup},
+    {"snap", &PhaseSeconds::snap},       {"untangle", &PhaseSeconds::untangle}, {"setup", &PhaseSeconds::setup}};
+
+/// The rest of a run's `seconds` outside the steps (statistics rows, snapshots), never negative.
+inline double other_seconds(const PhaseSeconds& phases, double seconds) { return std::max(0.0, seconds - phases.sum()); }
+
+/// "stellar 0.045, flips 0.041, ..., setup 0.002, other 0.013": each step's seconds and the rest
+/// of `seconds`, to the millisecond.
+std::string describe_phases(const PhaseSeconds& phases, double seconds);
 
 struct Result {
   Outcome outcome = Outcome::Completed;

@@ -75,8 +75,7 @@ TEST_CASE("job document: fields, links only when succeeded, round trip", "[api][
   r.thin_parts = ThinParts{12, 7, 1.25};
   PhaseSeconds phases;
   phases.stellar = 0.5, phases.projection = 0.25, phases.untangle = 0.125;
-  r.seconds_by_step = phases;
-  r.remesh_seconds = 1.0;
+  r.seconds_by_step = JobRecord::StepSeconds{phases, 1.0};
   doc = job_to_json(r, "/api/v1", r.created_at + 100);
   CHECK(doc["seconds_by_step"]["stellar"] == 0.5);
   CHECK(doc["seconds_by_step"]["projection"] == 0.25);
@@ -106,10 +105,10 @@ TEST_CASE("job document: fields, links only when succeeded, round trip", "[api][
   CHECK(back.thin_parts->in_thin_parts == 7);
   CHECK(back.thin_parts->limit == 1.25);
   REQUIRE(back.seconds_by_step);
-  CHECK(back.seconds_by_step->stellar == 0.5);
-  CHECK(back.seconds_by_step->untangle == 0.125);
-  CHECK(back.seconds_by_step->sum() == 0.875);
-  CHECK(back.remesh_seconds == std::optional<double>(1.0));
+  CHECK(back.seconds_by_step->steps.stellar == 0.5);
+  CHECK(back.seconds_by_step->steps.untangle == 0.125);
+  CHECK(back.seconds_by_step->steps.sum() == 0.875);
+  CHECK(back.seconds_by_step->total == 1.0);
   // A document written before the fields existed still reads.
   json old = doc;
   old.erase("thin_parts");
