@@ -325,8 +325,11 @@ class Cleanup {
     const std::vector<Vec3> around = split_neighbours(mesh_, e);
     const Vec3 normal = geom::vertex_normal(mesh_, v0) + geom::vertex_normal(mesh_, v1);
     const Vec3 p0 = a + (b - a) * equalizing_parameter(a, b, around, target());
+    // Through v0's kd-tree answer: exact wherever it came from (reference_surface.h), and the split
+    // point lies next to v0.
+    NeighbourCache* cache = cache_of(v0);
     auto project = [&](const Vec3& x) {
-      if (!mesh_.is_boundary(e)) return reference_.closest_point(x, normal);
+      if (!mesh_.is_boundary(e)) return cache ? reference_.closest_point(x, normal, *cache) : reference_.closest_point(x, normal);
       return reference_.has_boundary() ? reference_.closest_boundary_point(x) : x;
     };
     Vec3 p = project(p0);

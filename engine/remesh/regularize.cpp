@@ -38,7 +38,7 @@ class Regularizer {
 
  private:
   /// Algorithm 4's safety checks and angle rule.
-  bool allowed(EdgeHandle e) const { return flip_is_safe(mesh_, e, f_); }
+  bool allowed(EdgeHandle e) const { return flip_is_safe(mesh_, e, f_, &info_); }
 
   void flip(EdgeHandle e, const Quad& q) {
     mesh_.flip(e);

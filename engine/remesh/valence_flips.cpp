@@ -29,12 +29,15 @@ VertexInfo::VertexInfo(const TriMesh& mesh, unsigned threads)
   });
 }
 
-bool flip_is_safe(const TriMesh& mesh, EdgeHandle e, double f) {
+bool flip_is_safe(const TriMesh& mesh, EdgeHandle e, double f, const VertexInfo* info) {
   if (mesh.status(e).deleted() || mesh.is_boundary(e) || !mesh.is_flip_ok(e)) return false;
   const Quad q = quad_of(mesh, e);
   // The ends lose an edge: keep interior valence >= 3 and boundary valence >= 2.
-  for (VertexHandle v : {q.v0, q.v1})
-    if (mesh.valence(v) <= (mesh.is_boundary(v) ? 2u : 3u)) return false;
+  for (VertexHandle v : {q.v0, q.v1}) {
+    const bool boundary = info ? info->boundary[v.idx()] != 0 : mesh.is_boundary(v);
+    const int valence = info ? info->valence[v.idx()] : static_cast<int>(mesh.valence(v));
+    if (valence <= (boundary ? 2 : 3)) return false;
+  }
   const Vec3 &p0 = mesh.point(q.v0), &p1 = mesh.point(q.v1), &p2 = mesh.point(q.v2), &p3 = mesh.point(q.v3);
   // Old faces (v0, v1, v2), (v1, v0, v3); new faces (v3, v1, v2), (v2, v0, v3).
   const Vec3 old_a = geom::cross_normal(p0, p1, p2), old_b = geom::cross_normal(p1, p0, p3);
@@ -95,7 +98,7 @@ std::size_t sweep(TriMesh& mesh, double f, VertexInfo& info, SweepMarks* marks) 
     if (mesh.is_boundary(e)) return;
     const Quad q = quad_of(mesh, e);
     if (marks && !marks->any(q)) return;
-    if (!info.improves(q) || !flip_is_safe(mesh, e, f)) return;
+    if (!info.improves(q) || !flip_is_safe(mesh, e, f, &info)) return;
     mesh.flip(e);
     info.flipped(q);
     if (marks)

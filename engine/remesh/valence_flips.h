@@ -119,7 +119,8 @@ std::size_t valence_flip_sweep(TriMesh& mesh, double f);
 std::size_t valence_flips(TriMesh& mesh, double f, int max_sweeps = 3, unsigned threads = 1);
 
 /// Safety part of a flip alone (legal, no fold, no degenerate triangle, minimum angle no lower than
-/// f * before). Used by the interval cleanup too.
-bool flip_is_safe(const TriMesh& mesh, OpenMesh::EdgeHandle e, double f);
+/// f * before). Used by the interval cleanup too. With `info` (current for `mesh`), the ends'
+/// valences come from it instead of circulating them: the same answer.
+bool flip_is_safe(const TriMesh& mesh, OpenMesh::EdgeHandle e, double f, const VertexInfo* info = nullptr);
 
 }  // namespace remesh
