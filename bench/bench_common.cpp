@@ -31,7 +31,7 @@ TriMesh load_mesh(const std::string& path) {
   // Drop unreferenced vertices (scans carry some).
   for (auto v : mesh.vertices())
     if (mesh.is_isolated(v)) mesh.delete_vertex(v, false);
-  mesh.garbage_collection();
+  collect_garbage(mesh);
   return mesh;
 }
 

@@ -41,7 +41,7 @@ RunOutput run_job(const remesh::api::JobRecord& job, std::string_view upload, un
   out.seconds = result.seconds;
   if (result.outcome == remesh::Outcome::Cancelled) return out;
 
-  mesh.garbage_collection();
+  collect_garbage(mesh);
   for (const std::string& f : remesh::api::remeshed_formats())
     out.files["remeshed." + f] = remesh::write_mesh(mesh, format_of(f));
   remesh::ReferenceSurface reference(loaded.mesh);

@@ -6,6 +6,8 @@
 #include <OpenMesh/Core/Mesh/PolyMesh_ArrayKernelT.hh>
 #include <OpenMesh/Core/Mesh/TriMesh_ArrayKernelT.hh>
 
+#include <deque>
+
 namespace remesh {
 
 struct MeshTraits : public OpenMesh::DefaultTraits {
@@ -22,5 +24,33 @@ using TriMesh = OpenMesh::TriMesh_ArrayKernelT<MeshTraits>;
 /// A polygon mesh (the trivalent dual).
 using PolyMesh = OpenMesh::PolyMesh_ArrayKernelT<MeshTraits>;
 using Vec3 = OpenMesh::Vec3d;
+
+/// mesh.valence(v), compiled with this project's flags (the library's copy, built with assertions
+/// on, checks every handle it steps over; the statistics and the flips count every vertex's
+/// valence in every iteration).
+template <class Mesh>
+unsigned vertex_valence(const Mesh& mesh, OpenMesh::VertexHandle v) {
+  unsigned n = 0;
+  for (auto h : mesh.voh_range(v)) {
+    (void)h;
+    ++n;
+  }
+  return n;
+}
+
+/// mesh.garbage_collection(), compiled with this project's flags. Debian's libOpenMeshCore is built
+/// with assertions on, and its garbage_collection() checks the status property's type on every
+/// status lookup by building and comparing std::string type names: a million lookups per
+/// collection of cow's refined mesh (6 000 vertices), 10 % of a remeshing run on one thread. The
+/// overload that updates handles is a template in OpenMesh's headers: called here with containers
+/// of another type than the library's own instantiation, it is compiled into this project, with
+/// NDEBUG. The same compaction, element for element.
+template <class Mesh>
+void collect_garbage(Mesh& mesh) {
+  std::deque<OpenMesh::VertexHandle*> vertices;
+  std::deque<OpenMesh::HalfedgeHandle*> halfedges;
+  std::deque<OpenMesh::FaceHandle*> faces;
+  mesh.garbage_collection(vertices, halfedges, faces);
+}
 
 }  // namespace remesh

@@ -96,7 +96,7 @@ PolyMesh build_dual(const TriMesh& primal, const ReferenceSurface* reference) {
 PolyMesh trivalent_dual(const TriMesh& primal, const ReferenceSurface* reference) {
   if (!has_deleted_elements(primal)) return build_dual(primal, reference);
   TriMesh compact = primal;
-  compact.garbage_collection();
+  collect_garbage(compact);
   return build_dual(compact, reference);
 }
 

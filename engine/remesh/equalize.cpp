@@ -349,7 +349,7 @@ Result equalize(TriMesh& mesh, const Params& params, const OnIteration& on_itera
   Result result;
   PhaseSeconds& phases = result.phases;
   PhaseTimer setup_timer(phases.setup);
-  mesh.garbage_collection();
+  collect_garbage(mesh);
   release_normals(mesh);
   auto reference = std::make_unique<ReferenceSurface>(mesh);
   auto features = std::make_unique<FeatureSnap>(mesh, params.e_min);
@@ -394,7 +394,7 @@ Result equalize(TriMesh& mesh, const Params& params, const OnIteration& on_itera
       const double m_i = std::min(2.0 * mean_edge_length(mesh, threads), m);
       const std::vector<unsigned> list = make_priority_list(mesh, m_i, sigma, threads);
       const StellarCounts stellar = stellar_operations(mesh, list, m_i, sigma);
-      mesh.garbage_collection();
+      collect_garbage(mesh);
       counters.splits = stellar.splits;
       counters.collapses = stellar.collapses;
     }

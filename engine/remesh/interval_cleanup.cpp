@@ -171,7 +171,7 @@ class Cleanup {
   /// elements are skipped, and collecting (which renumbers every element) after every round took a
   /// third of the cleanup's time on armadillo_86k.
   void finish() {
-    if (collapsed_) mesh_.garbage_collection();
+    if (collapsed_) collect_garbage(mesh_);
     collapsed_ = false;
   }
 
@@ -329,7 +329,8 @@ class Cleanup {
     // point lies next to v0.
     NeighbourCache* cache = cache_of(v0);
     auto project = [&](const Vec3& x) {
-      if (!mesh_.is_boundary(e)) return cache ? reference_.closest_point(x, normal, *cache) : reference_.closest_point(x, normal);
+      if (!mesh_.is_boundary(e))
+        return cache ? reference_.closest_point(x, normal, *cache) : reference_.closest_point(x, normal);
       return reference_.has_boundary() ? reference_.closest_boundary_point(x) : x;
     };
     Vec3 p = project(p0);

@@ -96,7 +96,7 @@ IterationStats measure(const TriMesh& mesh, double e_min, double e_max, unsigned
       ++c.vertices;
       if (mesh.is_boundary(v)) continue;  // includes isolated vertices
       ++c.interior;
-      if (mesh.valence(v) == 6) ++c.regular;
+      if (vertex_valence(mesh, v) == 6) ++c.regular;
     }
     vertex_blocks[block] = c;
   });

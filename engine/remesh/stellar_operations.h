@@ -12,7 +12,7 @@
 ///   4 vertices (a tetrahedron-sized component does not vanish);
 /// - not in the thesis: a collapse keeps a tip where it is (is_tip; the other end collapses onto
 ///   it, as onto a boundary vertex), unless both ends are tips.
-/// The edits leave deleted elements behind: call mesh.garbage_collection() after a pass.
+/// The edits leave deleted elements behind: call collect_garbage(mesh) (core/mesh.h) after a pass.
 
 #include <cstddef>
 #include <vector>

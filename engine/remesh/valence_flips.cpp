@@ -24,7 +24,7 @@ VertexInfo::VertexInfo(const TriMesh& mesh, unsigned threads)
   parallel_for(mesh.n_vertices(), threads, [&](std::size_t i) {
     const auto v = mesh.vertex_handle(static_cast<unsigned>(i));
     if (mesh.status(v).deleted()) return;
-    valence[i] = static_cast<int>(mesh.valence(v));
+    valence[i] = static_cast<int>(vertex_valence(mesh, v));
     boundary[i] = mesh.is_boundary(v);
   });
 }
@@ -35,7 +35,7 @@ bool flip_is_safe(const TriMesh& mesh, EdgeHandle e, double f, const VertexInfo*
   // The ends lose an edge: keep interior valence >= 3 and boundary valence >= 2.
   for (VertexHandle v : {q.v0, q.v1}) {
     const bool boundary = info ? info->boundary[v.idx()] != 0 : mesh.is_boundary(v);
-    const int valence = info ? info->valence[v.idx()] : static_cast<int>(mesh.valence(v));
+    const int valence = info ? info->valence[v.idx()] : static_cast<int>(vertex_valence(mesh, v));
     if (valence <= (boundary ? 2 : 3)) return false;
   }
   const Vec3 &p0 = mesh.point(q.v0), &p1 = mesh.point(q.v1), &p2 = mesh.point(q.v2), &p3 = mesh.point(q.v3);

@@ -89,6 +89,40 @@ TEST_CASE("splits and collapses keep the mesh valid and its topology", "[steps]"
   CHECK(test::count_components(mesh) == 1);
 }
 
+TEST_CASE("collect_garbage compacts a mesh exactly as OpenMesh's garbage_collection", "[steps]") {
+  // core/mesh.h: the same compaction compiled without the library's assertions.
+  for (TriMesh mesh :
+       {test::make_icosphere(3, 10.0), test::make_torus(24, 12, 10.0, 4.0), test::make_open_grid(9, 7, 1.0)}) {
+    for (unsigned i = 0; i < mesh.n_edges(); i += 6) split_edge(mesh, mesh.edge_handle(i), 1.0);
+    std::size_t collapses = 0;
+    for (unsigned i = 0; i < mesh.n_edges(); i += 4) {
+      const EdgeHandle e = mesh.edge_handle(i);
+      CollapsePlan plan;
+      if (mesh.status(e).deleted() || !plan_collapse(mesh, e, 1.0, 1e9, plan)) continue;
+      apply_collapse(mesh, plan);
+      ++collapses;
+    }
+    REQUIRE(collapses > 5);
+    TriMesh theirs = mesh;
+    theirs.garbage_collection();
+    collect_garbage(mesh);
+    REQUIRE(mesh.n_vertices() == theirs.n_vertices());
+    REQUIRE(mesh.n_edges() == theirs.n_edges());
+    REQUIRE(mesh.n_faces() == theirs.n_faces());
+    for (unsigned v = 0; v < mesh.n_vertices(); ++v) {
+      CHECK(mesh.point(mesh.vertex_handle(v)) == theirs.point(theirs.vertex_handle(v)));
+      CHECK(vertex_valence(mesh, mesh.vertex_handle(v)) == theirs.valence(theirs.vertex_handle(v)));
+    }
+    for (unsigned h = 0; h < mesh.n_halfedges(); ++h) {
+      const auto a = mesh.halfedge_handle(h), b = theirs.halfedge_handle(h);
+      CHECK(mesh.to_vertex_handle(a) == theirs.to_vertex_handle(b));
+      CHECK(mesh.next_halfedge_handle(a) == theirs.next_halfedge_handle(b));
+      CHECK(mesh.face_handle(a) == theirs.face_handle(b));
+    }
+    CHECK(test::check_mesh_valid(mesh) == "");
+  }
+}
+
 TEST_CASE("boundary collapses stay on the boundary and never pinch", "[steps]") {
   TriMesh mesh = test::make_open_grid(8, 8, 1.0);
   std::size_t boundary_collapses = 0;
