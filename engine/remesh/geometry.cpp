@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <vector>
 
 #include "core/parallel.h"
 
@@ -163,26 +164,48 @@ double angle_deficit(const TriMesh& mesh, OpenMesh::VertexHandle v) {
 
 bool move_is_safe(const TriMesh& mesh, OpenMesh::VertexHandle v, const Vec3& p, double min_adjacent_cos) {
   AngleFloor floor([&] { return star_min_angle(mesh, v); });
+  // The star's faces with their normals before and after the move, each computed once (the fold
+  // checks read each star face's two or three times); kept per thread to spare an allocation.
+  struct StarFace {
+    OpenMesh::FaceHandle f;
+    Vec3 q[3];  ///< corners after the move
+    Vec3 before, after;
+  };
+  thread_local std::vector<StarFace> star;
+  star.clear();
+  for (auto f : mesh.vf_range(v)) {
+    StarFace& s = star.emplace_back();
+    s.f = f;
+    OpenMesh::VertexHandle c[3];
+    face_vertices(mesh, f, c);
+    for (int k = 0; k < 3; ++k) s.q[k] = c[k] == v ? p : mesh.point(c[k]);
+    s.before = face_normal(mesh, f);
+    s.after = cross_normal(s.q[0], s.q[1], s.q[2]);  // moved_normal(mesh, f, v, p)
+  }
+  auto normals = [&](OpenMesh::FaceHandle g, Vec3& before, Vec3& after) {
+    for (const StarFace& s : star)
+      if (s.f == g) {
+        before = s.before, after = s.after;
+        return;
+      }
+    before = face_normal(mesh, g), after = moved_normal(mesh, g, v, p);
+  };
   // No fold between a face of the star and any of its neighbours.
   for (auto h : mesh.voh_range(v)) {
     const auto f = mesh.face_handle(h);
     if (!f.is_valid()) continue;
+    Vec3 f_before, f_after;
+    normals(f, f_before, f_after);
     for (auto g : {mesh.opposite_face_handle(h), mesh.opposite_face_handle(mesh.next_halfedge_handle(h))}) {
       if (!g.is_valid()) continue;
-      if (!adjacent_ok(face_normal(mesh, f), face_normal(mesh, g), moved_normal(mesh, f, v, p),
-                       moved_normal(mesh, g, v, p), min_adjacent_cos))
-        return false;
+      Vec3 g_before, g_after;
+      normals(g, g_before, g_after);
+      if (!adjacent_ok(f_before, g_before, f_after, g_after, min_adjacent_cos)) return false;
     }
   }
-  for (auto f : mesh.vf_range(v)) {
-    OpenMesh::VertexHandle c[3];
-    face_vertices(mesh, f, c);
-    Vec3 q[3];
-    for (int k = 0; k < 3; ++k) q[k] = c[k] == v ? p : mesh.point(c[k]);
-    const Vec3 before = face_normal(mesh, f);
-    const Vec3 after = cross_normal(q[0], q[1], q[2]);
-    if (!normals_agree(before, after)) return false;
-    if (floor.breaks(q[0], q[1], q[2])) return false;
+  for (const StarFace& s : star) {
+    if (!normals_agree(s.before, s.after)) return false;
+    if (floor.breaks(s.q[0], s.q[1], s.q[2])) return false;
   }
   return true;
 }
