@@ -88,10 +88,15 @@ struct ReferenceSurface::Impl {
       std::pair<double, std::uint32_t> by_distance[NeighbourCache::kCacheSize];
       for (std::uint32_t i = 0; i < cache.count; ++i)
         by_distance[i] = {(points[cache.idx[i]] - p).sqrnorm(), cache.idx[i]};
-      // The k nearest, unordered but for the nearest first (closest_point prunes by it).
-      std::nth_element(by_distance, by_distance + (k - 1), by_distance + cache.count);
+      // The k nearest, unordered but for the nearest first (closest_point prunes by it). The order
+      // of std::pair, spelt out: C++20 derives pair's < from <=>, whose partial ordering of doubles
+      // cost a third of this function.
+      auto closer = [](const std::pair<double, std::uint32_t>& a, const std::pair<double, std::uint32_t>& b) {
+        return a.first < b.first || (!(b.first < a.first) && a.second < b.second);
+      };
+      std::nth_element(by_distance, by_distance + (k - 1), by_distance + cache.count, closer);
       const double kth = by_distance[k - 1].first;
-      std::iter_swap(by_distance, std::min_element(by_distance, by_distance + k));
+      std::iter_swap(by_distance, std::min_element(by_distance, by_distance + k, closer));
       const double moved = (p - cache.query).norm();
       if (std::sqrt(kth) + moved < cache.radius) {
         for (std::size_t i = 0; i < k; ++i) idx[i] = by_distance[i].second;
