@@ -59,15 +59,6 @@ struct Loop {
 /// process forked from one with helpers, when there are none.
 class Pool {
  public:
-  ~Pool() {
-    {
-      std::lock_guard lock(mutex_);
-      stopping_ = true;
-    }
-    wake_.notify_all();
-    for (auto& t : threads_) t.join();
-  }
-
   /// Offers `loop` to `helpers` helper threads, starting more threads if there are fewer.
   void offer(const std::shared_ptr<Loop>& loop, unsigned helpers) {
     bool sleeping;
@@ -81,27 +72,22 @@ class Pool {
     if (sleeping) wake_.notify_all();
   }
 
-  /// The pool of this process (a forked child gets a new one: the parent's threads are not in it).
+  /// The pool of this process. Never destroyed: its helpers end with the process (a destructor
+  /// would join them, and in a forked child that calls exit() they do not exist). A forked child
+  /// gets a pool of its own.
   static Pool& instance() {
     static std::mutex mutex;
     static Pool* pool = nullptr;
     static pid_t owner = 0;
     std::lock_guard lock(mutex);
     if (!pool || owner != getpid()) {
-      // In a forked child the parent's pool is abandoned, not destroyed: joining threads that do
-      // not exist here would hang.
-      pool = owner == 0 ? &main_pool() : new Pool;
+      pool = new Pool;  // the parent's, in a forked child, is abandoned with its absent threads
       owner = getpid();
     }
     return *pool;
   }
 
  private:
-  static Pool& main_pool() {
-    static Pool pool;
-    return pool;
-  }
-
   void work() {
     for (;;) {
       // A run's loops come in quick succession (normals, filter, projection, guards, statistics,
@@ -113,9 +99,8 @@ class Pool {
       {
         std::unique_lock lock(mutex_);
         ++sleepers_;
-        wake_.wait(lock, [this] { return stopping_ || !queue_.empty(); });
+        wake_.wait(lock, [this] { return !queue_.empty(); });
         --sleepers_;
-        if (queue_.empty()) return;  // stopping
         loop = std::move(queue_.front());
         queue_.pop_front();
         queued_.store(queue_.size(), std::memory_order_release);
@@ -132,7 +117,6 @@ class Pool {
   std::vector<std::thread> threads_;
   std::atomic<std::size_t> queued_{0};  ///< queue_.size(), read without the lock while spinning
   int sleepers_ = 0;                     ///< helpers waiting on wake_
-  bool stopping_ = false;
 };
 
 }  // namespace
