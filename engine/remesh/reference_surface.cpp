@@ -60,7 +60,14 @@ struct ReferenceSurface::Impl {
   Csr vertex_triangles;             ///< triangles incident to each vertex
   /// per vertex: its longest incident edge, so every incident triangle lies within this distance
   std::vector<double> vertex_reach;
-  double largest_reach = 0;  ///< the largest vertex_reach
+  /// opposite_side_distance's search: the vertices within limit + search_reach of the query find
+  /// every triangle whose longest edge is at most search_reach (a point of a triangle lies within
+  /// its longest edge of each corner); the longer triangles, a hundredth of them, are in
+  /// long_triangles and looked at one by one. An uneven input has a few very long edges (cheese:
+  /// median 0.64, longest 9.5, scaled for the simplification): a search radius of the longest
+  /// edge took in much of the mesh, 760 000 instructions a query.
+  double search_reach = 0;
+  std::vector<std::uint32_t> long_triangles;
   /// per triangle: the triangle across its edge (corner k, corner k+1), or kNone (boundary edge)
   std::vector<std::array<std::uint32_t, 3>> across;
   static constexpr std::uint32_t kNone = UINT32_MAX;
@@ -177,14 +184,24 @@ ReferenceSurface::ReferenceSurface(const TriMesh& mesh, std::size_t neighbours)
     for (auto v : tri.corners) ++m.vertex_triangles.offsets[v + 1];
   }
   m.vertex_reach.assign(nv, 0.0);
-  for (const auto& tri : m.triangles)
+  std::vector<double> longest(nt, 0.0);  // per triangle
+  for (std::size_t t = 0; t < nt; ++t)
     for (int k = 0; k < 3; ++k) {
-      const std::uint32_t a = tri.corners[k], b = tri.corners[(k + 1) % 3];
+      const auto& corners = m.triangles[t].corners;
+      const std::uint32_t a = corners[k], b = corners[(k + 1) % 3];
       const double l = (m.points[a] - m.points[b]).norm();
       m.vertex_reach[a] = std::max(m.vertex_reach[a], l);
       m.vertex_reach[b] = std::max(m.vertex_reach[b], l);
-      m.largest_reach = std::max(m.largest_reach, l);
+      longest[t] = std::max(longest[t], l);
     }
+  {
+    std::vector<double> sorted = longest;
+    const std::size_t rank = nt - 1 - nt / 100;
+    std::nth_element(sorted.begin(), sorted.begin() + rank, sorted.end());
+    m.search_reach = sorted[rank];
+    for (std::size_t t = 0; t < nt; ++t)
+      if (longest[t] > m.search_reach) m.long_triangles.push_back(static_cast<std::uint32_t>(t));
+  }
   for (std::size_t v = 0; v < nv; ++v) m.vertex_triangles.offsets[v + 1] += m.vertex_triangles.offsets[v];
   m.vertex_triangles.items.resize(m.vertex_triangles.offsets[nv]);
   {
@@ -248,24 +265,31 @@ double ReferenceSurface::opposite_side_distance(const Vec3& p, const Vec3& norma
   constexpr double kOpposite = -0.3;
   if (!(limit > 0)) return std::numeric_limits<double>::infinity();
   double best2 = limit * limit;
-  // A triangle nearer than `limit` has a corner v within limit + vertex_reach[v] of p.
+  bool any = false;
+  auto consider = [&](const Impl::Triangle& tri) {
+    if ((tri.normal | normal) >= kOpposite) return;
+    // Every point of the triangle lies within its radius of its centre (the margin keeps the test
+    // conservative against rounding).
+    const double reach = (std::sqrt(best2) + tri.radius) * (1.0 + 1e-9);
+    if ((tri.centre - p).sqrnorm() > reach * reach) return;
+    const Vec3 c = geom::closest_point_on_triangle(p, m.points[tri.corners[0]], m.points[tri.corners[1]],
+                                                   m.points[tri.corners[2]]);
+    const double c2 = (c - p).sqrnorm();
+    if (c2 < best2) best2 = c2, any = true;
+  };
+  // A triangle nearer than `limit` has every corner v within limit + vertex_reach[v] of p; those
+  // with an edge longer than search_reach are looked at from the list (Impl::search_reach).
   std::vector<std::pair<std::uint32_t, double>> found;
   const double q[3] = {p[0], p[1], p[2]};
-  const double radius = limit + m.largest_reach;
+  const double radius = limit + m.search_reach;
   m.tree->radiusSearch(q, radius * radius, found, nanoflann::SearchParams(32, 0.0f, false));
-  bool any = false;
   for (const auto& [v, d2] : found) {
     const double reach = limit + m.vertex_reach[v];
     if (d2 > reach * reach) continue;
-    for (std::uint32_t j = m.vertex_triangles.offsets[v]; j < m.vertex_triangles.offsets[v + 1]; ++j) {
-      const Impl::Triangle& tri = m.triangles[m.vertex_triangles.items[j]];
-      if ((tri.normal | normal) >= kOpposite) continue;
-      const Vec3 c = geom::closest_point_on_triangle(p, m.points[tri.corners[0]], m.points[tri.corners[1]],
-                                                     m.points[tri.corners[2]]);
-      const double c2 = (c - p).sqrnorm();
-      if (c2 < best2) best2 = c2, any = true;
-    }
+    for (std::uint32_t j = m.vertex_triangles.offsets[v]; j < m.vertex_triangles.offsets[v + 1]; ++j)
+      consider(m.triangles[m.vertex_triangles.items[j]]);
   }
+  for (std::uint32_t t : m.long_triangles) consider(m.triangles[t]);
   return any ? std::sqrt(best2) : std::numeric_limits<double>::infinity();
 }
 

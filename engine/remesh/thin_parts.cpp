@@ -9,6 +9,25 @@
 
 namespace remesh {
 
+namespace {
+
+/// Is the reference thinner than `limit` at edge e (see thin_parts.h)? False for an edge whose
+/// faces' normals cancel or are degenerate.
+bool in_thin_part(const TriMesh& mesh, const ReferenceSurface& reference, OpenMesh::EdgeHandle e, double limit) {
+  const auto h = mesh.halfedge_handle(e, 0);
+  Vec3 normal(0, 0, 0);
+  for (auto g : {h, mesh.opposite_halfedge_handle(h)})
+    if (!mesh.is_boundary(g)) {
+      const Vec3 n = geom::face_normal(mesh, mesh.face_handle(g));
+      if (const double l = n.norm(); l > 0) normal += n / l;
+    }
+  if (!(normal.norm() > 0)) return false;
+  const Vec3 mid = 0.5 * (mesh.point(mesh.from_vertex_handle(h)) + mesh.point(mesh.to_vertex_handle(h)));
+  return reference.opposite_side_distance(mid, normal.normalized(), limit) < limit;
+}
+
+}  // namespace
+
 ThinParts thin_parts(const TriMesh& mesh, const ReferenceSurface& reference, double e_min, double e_max,
                      unsigned threads) {
   ThinParts out;
@@ -22,16 +41,7 @@ ThinParts thin_parts(const TriMesh& mesh, const ReferenceSurface& reference, dou
   out.outside = outside.size();
   std::atomic<std::size_t> thin{0};
   parallel_for(outside.size(), threads, [&](std::size_t i) {
-    const auto h = mesh.halfedge_handle(outside[i], 0);
-    Vec3 normal(0, 0, 0);
-    for (auto g : {h, mesh.opposite_halfedge_handle(h)})
-      if (!mesh.is_boundary(g)) {
-        const Vec3 n = geom::face_normal(mesh, mesh.face_handle(g));
-        if (const double l = n.norm(); l > 0) normal += n / l;
-      }
-    if (!(normal.norm() > 0)) return;
-    const Vec3 mid = 0.5 * (mesh.point(mesh.from_vertex_handle(h)) + mesh.point(mesh.to_vertex_handle(h)));
-    if (reference.opposite_side_distance(mid, normal.normalized(), out.limit) < out.limit) ++thin;
+    if (in_thin_part(mesh, reference, outside[i], out.limit)) ++thin;
   }, 64);
   out.in_thin_parts = thin;
   return out;

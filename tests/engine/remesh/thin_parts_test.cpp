@@ -1,6 +1,7 @@
 // Why edges are left outside the interval: the thickness of the reference at them (thin_parts.h).
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <random>
@@ -35,16 +36,36 @@ double brute_opposite(const TriMesh& m, const Vec3& p, const Vec3& normal, doubl
 
 TEST_CASE("opposite_side_distance is the nearest triangle facing the other way within the limit", "[thin]") {
   std::mt19937 rng(7);
-  std::uniform_real_distribution<double> limit_of(0.05, 4.0), jitter(-0.2, 0.2);
+  std::uniform_real_distribution<double> limit_of(0.05, 4.0), jitter(-0.2, 0.2), coordinate(-1.0, 1.0);
+  // An uneven reference: a sphere with a spike, whose five triangles are far longer than the rest
+  // (the search looks at those one by one).
+  TriMesh spiked = test::make_icosphere(3, 2.0);
+  spiked.point(spiked.vertex_handle(0)) *= 15.0;
   for (const TriMesh& m : {test::make_torus(40, 10, 3.0, 0.4), test::make_torus(48, 24, 5.0, 2.0),
-                           test::make_double_torus(1.0, 2), test::make_icosphere(3, 2.0)}) {
+                           test::make_double_torus(1.0, 2), test::make_icosphere(3, 2.0), spiked}) {
     const ReferenceSurface reference(m);
     const std::vector<Vec3> normals = geom::vertex_normals(m, 1);
+    std::vector<double> area_below{0.0};  // cumulated face areas, to pick points evenly on the surface
+    for (auto f : m.faces()) area_below.push_back(area_below.back() + 0.5 * geom::face_normal(m, f).norm());
     std::size_t finite = 0;
-    for (int i = 0; i < 300; ++i) {
+    for (int i = 0; i < 600; ++i) {
       const auto v = m.vertex_handle(static_cast<unsigned>(rng() % m.n_vertices()));
-      const Vec3 p = m.point(v) + Vec3(jitter(rng), jitter(rng), jitter(rng));
-      const Vec3 n = normals[v.idx()].normalized();
+      Vec3 p = m.point(v) + Vec3(jitter(rng), jitter(rng), jitter(rng));
+      Vec3 n = normals[v.idx()].normalized();
+      // Every other query from a point on the surface picked evenly by area (often inside a long
+      // triangle, far from its corners), with a direction of its own, so that triangles of any
+      // size and orientation count.
+      if (i % 2 == 1) {
+        const double at = std::uniform_real_distribution<double>(0.0, area_below.back())(rng);
+        const auto f = m.face_handle(static_cast<unsigned>(
+            std::upper_bound(area_below.begin(), area_below.end(), at) - area_below.begin() - 1));
+        const double a = 0.5 * (1 + coordinate(rng)), b = 0.5 * (1 + coordinate(rng)) * (1 - a);
+        Vec3 c[3];
+        int k = 0;
+        for (auto u : m.fv_range(f)) c[k++] = m.point(u);
+        p = c[0] * a + c[1] * b + c[2] * (1 - a - b) + Vec3(jitter(rng), jitter(rng), jitter(rng));
+        if (const Vec3 r(coordinate(rng), coordinate(rng), coordinate(rng)); r.norm() > 0.1) n = r.normalized();
+      }
       const double limit = limit_of(rng);
       const double got = reference.opposite_side_distance(p, n, limit);
       const double want = brute_opposite(m, p, n, limit);
