@@ -91,6 +91,10 @@ struct ReferenceSurface::Impl {
   /// header), else from the kd-tree, refilling the cache.
   std::size_t nearest(const Vec3& p, std::uint32_t* idx, NeighbourCache& cache) const {
     const std::size_t k = std::min({neighbours, kMaxK, points.size()});
+    const std::size_t size = std::min(NeighbourCache::kCacheSize, points.size());
+    // On a miss, the cached vertices still bound the search: the `size` nearest to p lie no farther
+    // than the farthest of them (squared, with a margin against rounding; 0 = no bound).
+    double bound = 0;
     if (cache.surface == id && cache.count >= k) {
       std::pair<double, std::uint32_t> by_distance[NeighbourCache::kCacheSize];
       for (std::uint32_t i = 0; i < cache.count; ++i)
@@ -109,11 +113,28 @@ struct ReferenceSurface::Impl {
         for (std::size_t i = 0; i < k; ++i) idx[i] = by_distance[i].second;
         return k;
       }
+      if (cache.count == size) {
+        for (std::uint32_t i = 0; i < cache.count; ++i) bound = std::max(bound, by_distance[i].first);
+        bound = bound * (1 + 1e-9) + 1e-300;
+      }
     }
-    const std::size_t size = std::min(NeighbourCache::kCacheSize, points.size());
     double dist2[NeighbourCache::kCacheSize];
     const double q[3] = {p[0], p[1], p[2]};
-    const std::size_t found = tree->knnSearch(q, size, cache.idx, dist2);
+    std::size_t found = 0;
+    if (bound > 0) {
+      // nanoflann's k-nearest search, its worst distance starting at the bound instead of infinity,
+      // so that it prunes from the first leaf on. When it fills all `size` places, those are the
+      // nearest, in the same order as without the bound (a vertex nearer than the last of them is
+      // nearer than the bound: it is visited, in the same order); else the plain search runs.
+      // Measured (one thread, callgrind): cheese refined 13.04e9 -> 12.77e9 instructions, cow
+      // 5.21e9 -> 5.16e9; the same meshes.
+      nanoflann::KNNResultSet<double, std::uint32_t> result(size);
+      result.init(cache.idx, dist2);
+      dist2[size - 1] = bound;
+      tree->findNeighbors(result, q, nanoflann::SearchParams());
+      found = result.size();
+    }
+    if (found < size) found = tree->knnSearch(q, size, cache.idx, dist2);
     cache.surface = id;
     cache.query = p;
     cache.count = static_cast<std::uint32_t>(found);

@@ -1,6 +1,7 @@
 // Each step of Algorithm 1 alone.
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <random>
@@ -479,7 +480,7 @@ TEST_CASE("a reused neighbour cache gives the kd-tree's closest point", "[steps]
   const ReferenceSurface reference(torus);
   std::normal_distribution<double> g(0, 1);
   std::uniform_int_distribution<int> pick(0, static_cast<int>(torus.n_vertices()) - 1);
-  std::size_t reused = 0, refilled = 0;
+  std::size_t reused = 0, refilled = 0, refilled_after_move = 0;
   for (int walker = 0; walker < 40; ++walker) {
     NeighbourCache cache;
     Vec3 p = torus.point(torus.vertex_handle(pick(rng)));
@@ -488,15 +489,27 @@ TEST_CASE("a reused neighbour cache gives the kd-tree's closest point", "[steps]
       p += Vec3(g(rng), g(rng), g(rng)) * size;
       const Vec3 hint(g(rng), g(rng), g(rng));
       const Vec3 before = cache.query;
+      const bool was_filled = cache.count > 0;
       const Vec3 cached = reference.closest_point(p, hint, cache);
       const Vec3 fresh = reference.closest_point(p, hint);
       CHECK(std::abs((cached - p).norm() - (fresh - p).norm()) < 1e-12);
       CHECK((cached - fresh).norm() < 1e-9);
-      (cache.query == p && before != p) ? ++refilled : ++reused;
+      if (cache.query == p && before != p) {
+        ++refilled;
+        // A refill is the kd-tree's answer, in its order, whether or not the old cache bounded
+        // the search (it does after a move).
+        std::uint32_t nearest[NeighbourCache::kCacheSize];
+        REQUIRE(reference.nearest_vertices(p, NeighbourCache::kCacheSize, nearest) == cache.count);
+        CHECK(std::equal(nearest, nearest + cache.count, cache.idx));
+        if (was_filled) ++refilled_after_move;
+      } else {
+        ++reused;
+      }
     }
   }
   CHECK(reused > 0);
   CHECK(refilled > 40);  // every walker's first query, and jumps
+  CHECK(refilled_after_move > 40);
 }
 
 TEST_CASE("the interval cleanup is safe, keeps vertices on the reference and is idempotent", "[steps]") {
