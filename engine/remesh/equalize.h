@@ -66,7 +66,7 @@ struct PhaseSeconds {
   double snap = 0;        ///< feature snap (feature_snap.h)
   double untangle = 0;    ///< moving crossing faces apart (untangle.h), its mends not included
   double setup = 0;       ///< reference surface, its kd-tree and feature points (and again at each `pr`)
-  double sum() const { return stellar + flips + filter + projection + guards + cleanup + snap + untangle + setup; }
+  double sum() const;  ///< of every step (kPhaseFields)
 };
 
 /// The steps of PhaseSeconds by name, in the order of a run (the CLI, the API and the benchmark
@@ -79,6 +79,12 @@ inline constexpr PhaseField kPhaseFields[] = {
     {"stellar", &PhaseSeconds::stellar}, {"flips", &PhaseSeconds::flips},   {"filter", &PhaseSeconds::filter},
     {"projection", &PhaseSeconds::projection}, {"guards", &PhaseSeconds::guards}, {"cleanup", &PhaseSeconds::cleanup},
     {"snap", &PhaseSeconds::snap},       {"untangle", &PhaseSeconds::untangle}, {"setup", &PhaseSeconds::setup}};
+
+inline double PhaseSeconds::sum() const {
+  double total = 0;
+  for (const PhaseField& f : kPhaseFields) total += this->*f.seconds;
+  return total;
+}
 
 /// The rest of a run's `seconds` outside the steps (statistics rows, snapshots), never negative.
 inline double other_seconds(const PhaseSeconds& phases, double seconds) { return std::max(0.0, seconds - phases.sum()); }
