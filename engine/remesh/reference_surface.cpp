@@ -60,6 +60,16 @@ struct ReferenceSurface::Impl {
   Csr vertex_triangles;             ///< triangles incident to each vertex
   /// per vertex: its longest incident edge, so every incident triangle lies within this distance
   std::vector<double> vertex_reach;
+  /// Per vertex: a sphere around its incident triangles (the centre of their corners' bounding box,
+  /// the distance to the farthest corner), for closest_point's test of a whole vertex. Tighter
+  /// than the sphere of vertex_reach around the vertex itself, which reaches a whole longest edge
+  /// past the vertex in every direction: cheese's 30 candidates a query had 3 vertices passed
+  /// over with that one, 14 with this (its reference has slivers 3.6 by 0.17 around its holes).
+  struct Star {
+    Vec3 centre;
+    double radius = 0;
+  };
+  std::vector<Star> stars;
   /// opposite_side_distance's search: the vertices within limit + search_reach of the query find
   /// every triangle whose longest edge is at most search_reach (a point of a triangle lies within
   /// its longest edge of each corner); the longer triangles, a hundredth of them, are in
@@ -230,6 +240,20 @@ ReferenceSurface::ReferenceSurface(const TriMesh& mesh, std::size_t neighbours)
     for (std::size_t t = 0; t < nt; ++t)
       for (auto v : m.triangles[t].corners) m.vertex_triangles.items[fill[v]++] = static_cast<std::uint32_t>(t);
   }
+  m.stars.resize(nv);
+  for (std::size_t v = 0; v < nv; ++v) {
+    const std::uint32_t* begin = m.vertex_triangles.items.data() + m.vertex_triangles.offsets[v];
+    const std::uint32_t* end = m.vertex_triangles.items.data() + m.vertex_triangles.offsets[v + 1];
+    Vec3 lo = m.points[v], hi = lo;
+    for (const std::uint32_t* t = begin; t != end; ++t)
+      for (auto c : m.triangles[*t].corners) lo.minimize(m.points[c]), hi.maximize(m.points[c]);
+    Impl::Star& star = m.stars[v];
+    star.centre = 0.5 * (lo + hi);
+    double r2 = 0;
+    for (const std::uint32_t* t = begin; t != end; ++t)
+      for (auto c : m.triangles[*t].corners) r2 = std::max(r2, (m.points[c] - star.centre).sqrnorm());
+    star.radius = std::sqrt(r2) * (1 + 1e-9) + 1e-12;  // a margin against rounding
+  }
   // A triangle whose normal is nearly opposite to that of a larger neighbour across an edge lies
   // folded back onto it: a defect of the input (nefertiti has 96 such pairs: slivers that close
   // T-junctions of its base with their third corner on the wrong side). Its normal is noise, and a
@@ -348,12 +372,13 @@ Vec3 ReferenceSurface::Impl::closest_point(const Vec3& p, const Vec3& normal_hin
   const std::uint32_t epoch = seen.next(id, triangles.size());
   for (std::size_t i = 0; i < found; ++i) {
     const std::uint32_t v = idx[i];
-    // Skip the vertex when all its triangles (within vertex_reach of it) are farther than any
+    // Skip the vertex when all its triangles (within its star's sphere) are farther than any
     // candidate they could beat: one test instead of one per triangle (most of the 30 vertices are
-    // two or three rings away).
+    // two or three rings away). Measured (Table 4.2 setup, 2 threads): cheese refined and
+    // simplified 8 % faster than with the sphere of vertex_reach around the vertex; the same meshes.
     if (const double bound = use_hint ? std::max(best_d, agree_d) : best_d; bound < kInf) {
-      const double reach = m.vertex_reach[v] + bound;
-      if ((p - m.points[v]).sqrnorm() > reach * reach) continue;
+      const double reach = m.stars[v].radius + bound;
+      if ((p - m.stars[v].centre).sqrnorm() > reach * reach) continue;
     }
     for (std::uint32_t j = m.vertex_triangles.offsets[v]; j < m.vertex_triangles.offsets[v + 1]; ++j) {
       const std::uint32_t t = m.vertex_triangles.items[j];

@@ -80,9 +80,9 @@ TEST_CASE("projection's pruning is exact on slivers: with every vertex a candida
           "[reference]") {
   // A closed prism of 12 sides, radius 1 and height 6, capped by fans: its side triangles are
   // slivers 6 long and 0.5 wide, whose bounding spheres (radius 3) prune nothing, so the pruning by
-  // vertex reach and by plane distance decides (cheese.off's holes). With 26 vertices, fewer than
-  // the 30 nearest of Alg. 6, every triangle is a candidate and the answer must be the exact one,
-  // from inside, outside, beside the caps and far away.
+  // the sphere around each vertex's triangles and by plane distance decides (cheese.off's holes).
+  // With 26 vertices, fewer than the 30 nearest of Alg. 6, every triangle is a candidate and the
+  // answer must be the exact one, from inside, outside, beside the caps and far away.
   TriMesh m;
   constexpr int kSides = 12;
   std::vector<OpenMesh::VertexHandle> bottom, top;
@@ -112,4 +112,38 @@ TEST_CASE("projection's pruning is exact on slivers: with every vertex a candida
         ++checked;
       }
   CHECK(checked == 6 * 7 * 7);
+}
+
+TEST_CASE("projection's test of a whole vertex keeps a large triangle whose corners are far from the query",
+          "[reference]") {
+  // A triangle 30 units wide in the plane z = 0 and, as a second part, a small tetrahedron 0.5 above
+  // it. Near the triangle's corner (0, 0) the tetrahedron's vertices come first among the nearest
+  // and set the first bound (under 0.5), while the triangle's corners lie 4-27 units from p and the
+  // middle of the triangle 15: it is found only if the sphere taken around each corner's triangles
+  // holds the whole triangle. With 7 vertices, fewer than the 30 nearest of Alg. 6, every
+  // triangle is a candidate: the answer is the exact one.
+  TriMesh m;
+  const auto a = m.add_vertex(Vec3(0, 0, 0)), b = m.add_vertex(Vec3(30, 0, 0)), c = m.add_vertex(Vec3(0, 30, 0));
+  m.add_face(a, b, c);
+  const Vec3 apex(4, 4, 0.5);
+  const auto t0 = m.add_vertex(apex), t1 = m.add_vertex(apex + Vec3(0.3, 0, 0.2)),
+             t2 = m.add_vertex(apex + Vec3(0, 0.3, 0.2)), t3 = m.add_vertex(apex + Vec3(0, 0, 0.4));
+  m.add_face(t0, t2, t1);
+  m.add_face(t0, t1, t3);
+  m.add_face(t0, t3, t2);
+  m.add_face(t1, t2, t3);
+  const ReferenceSurface reference(m);
+  int checked = 0;
+  for (double x : {3.0, 3.6, 4.0, 4.4, 5.0})
+    for (double y : {3.0, 3.6, 4.0, 4.4, 5.0})
+      for (double h : {0.02, 0.1, 0.2}) {
+        const Vec3 p(x, y, h);
+        for (const Vec3& hint : {Vec3(0, 0, 0), Vec3(0, 0, 1)}) {
+          const Vec3 q = reference.closest_point(p, hint);
+          CHECK(std::abs((q - p).norm() - h) < 1e-12);
+          CHECK(std::abs(q[2]) < 1e-12);
+          ++checked;
+        }
+      }
+  CHECK(checked == 5 * 5 * 3 * 2);
 }
