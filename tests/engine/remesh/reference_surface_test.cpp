@@ -118,10 +118,10 @@ TEST_CASE("projection's test of a whole vertex keeps a large triangle whose corn
           "[reference]") {
   // A triangle 30 units wide in the plane z = 0 and, as a second part, a small tetrahedron 0.5 above
   // it. Near the triangle's corner (0, 0) the tetrahedron's vertices come first among the nearest
-  // and set the first bound (under 0.5), while the triangle's corners lie 4-27 units from p and the
-  // middle of the triangle 15: it is found only if the sphere taken around each corner's triangles
-  // holds the whole triangle. With 7 vertices, fewer than the 30 nearest of Alg. 6, every
-  // triangle is a candidate: the answer is the exact one.
+  // and set the first bound (under 0.5), while the triangle's corners lie 4-27 units from p, and
+  // the centre of the sphere around each corner's triangles (their bounding box's, (15, 15, 0))
+  // 14-17: the triangle is found only if that sphere holds all of it. With 7 vertices, fewer than
+  // the 30 nearest of Alg. 6, every triangle is a candidate: the answer is the exact one.
   TriMesh m;
   const auto a = m.add_vertex(Vec3(0, 0, 0)), b = m.add_vertex(Vec3(30, 0, 0)), c = m.add_vertex(Vec3(0, 30, 0));
   m.add_face(a, b, c);
