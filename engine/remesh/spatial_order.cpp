@@ -1,0 +1,126 @@
+#include "remesh/spatial_order.h"
+
+#include <algorithm>
+#include <cstdint>
+#include <limits>
+#include <utility>
+#include <vector>
+
+namespace remesh {
+
+namespace {
+
+/// The bits of x (21 of them) spread to every third bit.
+std::uint64_t spread_bits(std::uint64_t x) {
+  x &= 0x1fffff;
+  x = (x | x << 32) & 0x1f00000000ffffULL;
+  x = (x | x << 16) & 0x1f0000ff0000ffULL;
+  x = (x | x << 8) & 0x100f00f00f00f00fULL;
+  x = (x | x << 4) & 0x10c30c30c30c30c3ULL;
+  x = (x | x << 2) & 0x1249249249249249ULL;
+  return x;
+}
+
+/// Old index of each vertex in Morton order of the positions (21 bits a coordinate over the
+/// bounding box; ties by old index).
+std::vector<unsigned> morton_order(const TriMesh& mesh) {
+  const std::size_t n = mesh.n_vertices();
+  constexpr double kBig = std::numeric_limits<double>::max();
+  Vec3 lo(kBig, kBig, kBig), hi(-kBig, -kBig, -kBig);
+  for (auto v : mesh.vertices()) lo.minimize(mesh.point(v)), hi.maximize(mesh.point(v));
+  const Vec3 extent = hi - lo;
+  const double largest = std::max({extent[0], extent[1], extent[2]});
+  const double scale = largest > 0 ? 2097151.0 / largest : 0.0;  // 2^21 - 1
+  std::vector<std::pair<std::uint64_t, unsigned>> keys(n);
+  for (auto v : mesh.vertices()) {
+    const Vec3 q = (mesh.point(v) - lo) * scale;
+    std::uint64_t code = 0;
+    for (int k = 0; k < 3; ++k) {
+      const double c = q[k] >= 0 ? std::min(q[k], 2097151.0) : 0.0;  // (a NaN goes to 0)
+      code |= spread_bits(static_cast<std::uint64_t>(c)) << k;
+    }
+    keys[v.idx()] = {code, static_cast<unsigned>(v.idx())};
+  }
+  std::sort(keys.begin(), keys.end());
+  std::vector<unsigned> order(n);
+  for (std::size_t i = 0; i < n; ++i) order[i] = keys[i].second;
+  return order;
+}
+
+}  // namespace
+
+std::vector<unsigned> spatial_order(TriMesh& mesh) {
+  const std::size_t nv = mesh.n_vertices(), ne = mesh.n_edges(), nf = mesh.n_faces();
+  constexpr unsigned kNone = std::numeric_limits<unsigned>::max();
+
+  // Vertices along the curve; faces by their lowest new corner (ties: old order); edges as the faces
+  // in their new order first use them.
+  const std::vector<unsigned> vertex_order = morton_order(mesh);
+  std::vector<unsigned> new_vertex(nv);
+  for (std::size_t i = 0; i < nv; ++i) new_vertex[vertex_order[i]] = static_cast<unsigned>(i);
+  std::vector<std::pair<unsigned, unsigned>> face_keys(nf);
+  for (auto f : mesh.faces()) {
+    unsigned lowest = kNone;
+    for (auto v : mesh.fv_range(f)) lowest = std::min(lowest, new_vertex[v.idx()]);
+    face_keys[f.idx()] = {lowest, static_cast<unsigned>(f.idx())};
+  }
+  std::sort(face_keys.begin(), face_keys.end());
+  std::vector<unsigned> new_face(nf), new_edge(ne, kNone), edge_order;
+  edge_order.reserve(ne);
+  for (std::size_t i = 0; i < nf; ++i) {
+    const auto f = mesh.face_handle(face_keys[i].second);
+    new_face[f.idx()] = static_cast<unsigned>(i);
+    for (auto h : mesh.fh_range(f)) {
+      const int e = mesh.edge_handle(h).idx();
+      if (new_edge[e] == kNone) new_edge[e] = static_cast<unsigned>(edge_order.size()), edge_order.push_back(e);
+    }
+  }
+  // Edges no face holds (none in a valid triangle mesh) keep their relative order at the end.
+  for (std::size_t e = 0; e < ne; ++e)
+    if (new_edge[e] == kNone) new_edge[e] = static_cast<unsigned>(edge_order.size()), edge_order.push_back(e);
+
+  // The same connectivity under the new numbers, each edge's halfedge 0 still its halfedge 0, as
+  // plain arrays; the old mesh is freed before the new one is built (a third of a TriMesh's memory
+  // at the peak instead of a second TriMesh).
+  auto renumbered = [&](OpenMesh::HalfedgeHandle h) {
+    return static_cast<unsigned>(2 * new_edge[h.idx() / 2] + (h.idx() & 1));
+  };
+  struct Halfedge {
+    unsigned next, face, vertex;  // face: kNone on the boundary
+  };
+  std::vector<Halfedge> halfedges(2 * ne);
+  for (auto h : mesh.halfedges()) {
+    const auto f = mesh.face_handle(h);
+    halfedges[renumbered(h)] = {renumbered(mesh.next_halfedge_handle(h)), f.is_valid() ? new_face[f.idx()] : kNone,
+                                new_vertex[mesh.to_vertex_handle(h).idx()]};
+  }
+  std::vector<unsigned> face_halfedge(nf), vertex_halfedge(nv, kNone);
+  for (auto f : mesh.faces()) face_halfedge[new_face[f.idx()]] = renumbered(mesh.halfedge_handle(f));
+  for (auto v : mesh.vertices())
+    if (const auto h = mesh.halfedge_handle(v); h.is_valid()) vertex_halfedge[new_vertex[v.idx()]] = renumbered(h);
+  std::vector<Vec3> points(nv);
+  for (std::size_t i = 0; i < nv; ++i) points[i] = mesh.point(mesh.vertex_handle(vertex_order[i]));
+  mesh = TriMesh();
+
+  mesh.reserve(nv, ne, nf);
+  for (const Vec3& p : points) mesh.add_vertex(p);
+  for (std::size_t e = 0; e < ne; ++e)
+    mesh.new_edge(OpenMesh::VertexHandle(static_cast<int>(halfedges[2 * e + 1].vertex)),
+                  OpenMesh::VertexHandle(static_cast<int>(halfedges[2 * e].vertex)));
+  for (std::size_t i = 0; i < nf; ++i) mesh.new_face();
+  for (std::size_t h = 0; h < halfedges.size(); ++h) {
+    const OpenMesh::HalfedgeHandle g(static_cast<int>(h));
+    mesh.set_next_halfedge_handle(g, OpenMesh::HalfedgeHandle(static_cast<int>(halfedges[h].next)));
+    if (halfedges[h].face != kNone) mesh.set_face_handle(g, OpenMesh::FaceHandle(static_cast<int>(halfedges[h].face)));
+  }
+  for (std::size_t f = 0; f < nf; ++f)
+    mesh.set_halfedge_handle(OpenMesh::FaceHandle(static_cast<int>(f)),
+                             OpenMesh::HalfedgeHandle(static_cast<int>(face_halfedge[f])));
+  for (std::size_t v = 0; v < nv; ++v)
+    if (vertex_halfedge[v] != kNone)
+      mesh.set_halfedge_handle(OpenMesh::VertexHandle(static_cast<int>(v)),
+                               OpenMesh::HalfedgeHandle(static_cast<int>(vertex_halfedge[v])));
+  return new_vertex;
+}
+
+}  // namespace remesh
