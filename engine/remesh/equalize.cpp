@@ -119,9 +119,10 @@ constexpr int kExploreAfter = 2;
 /// (spatial_order.h) at the start, and after the stellar operations of an iteration once the splits
 /// and collapses since the last numbering reach kOrderShare of its vertices. Measured (Table 4.2
 /// setup, 2 threads, means over the five intervals of bench --spread): armadillo 7.46 -> 3.98 s,
-/// nefertiti 10.1 -> 6.1 s (each numbering takes ~50 ms there), with the same quality within the
-/// runs' spread; a share of 0.05 gave 4.08 and 6.24 s, 0.15 4.33 and 7.01 s, every iteration 4.43
-/// and 6.72 s. Below ~16 000 vertices the mesh stays in the caches: fandisk (13 000) gained
+/// nefertiti 10.1 -> 6.1 s (each numbering takes ~60 ms there, 13 in its run), with the same
+/// quality within the runs' spread. A share of 0.05 gave 4.08 and 6.24 s, 0.15 4.33 and 7.01 s,
+/// every iteration 4.43 and 6.72 s; 0.02 measured again gave 4.55 and 6.72 s, so only the last two
+/// are clearly slower. Below ~16 000 vertices the mesh stays in the caches: fandisk (13 000) gained
 /// nothing per iteration; smaller meshes keep their numbering, and so their meshes bit for bit.
 constexpr double kOrderShare = 0.02;
 constexpr std::size_t kOrderMinVertices = 16384;
