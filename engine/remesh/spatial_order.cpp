@@ -58,17 +58,18 @@ std::vector<unsigned> spatial_order(TriMesh& mesh) {
   const std::vector<unsigned> vertex_order = morton_order(mesh);
   std::vector<unsigned> new_vertex(nv);
   for (std::size_t i = 0; i < nv; ++i) new_vertex[vertex_order[i]] = static_cast<unsigned>(i);
-  std::vector<std::pair<unsigned, unsigned>> face_keys(nf);
+  // Faces by a counting sort on their lowest corner, stable in their old order.
+  std::vector<unsigned> lowest(nf, kNone), face_order(nf), first(nv + 1, 0);
   for (auto f : mesh.faces()) {
-    unsigned lowest = kNone;
-    for (auto v : mesh.fv_range(f)) lowest = std::min(lowest, new_vertex[v.idx()]);
-    face_keys[f.idx()] = {lowest, static_cast<unsigned>(f.idx())};
+    for (auto v : mesh.fv_range(f)) lowest[f.idx()] = std::min(lowest[f.idx()], new_vertex[v.idx()]);
+    ++first[lowest[f.idx()] + 1];
   }
-  std::sort(face_keys.begin(), face_keys.end());
+  for (std::size_t v = 0; v < nv; ++v) first[v + 1] += first[v];
+  for (std::size_t f = 0; f < nf; ++f) face_order[first[lowest[f]]++] = static_cast<unsigned>(f);
   std::vector<unsigned> new_face(nf), new_edge(ne, kNone), edge_order;
   edge_order.reserve(ne);
   for (std::size_t i = 0; i < nf; ++i) {
-    const auto f = mesh.face_handle(face_keys[i].second);
+    const auto f = mesh.face_handle(face_order[i]);
     new_face[f.idx()] = static_cast<unsigned>(i);
     for (auto h : mesh.fh_range(f)) {
       const int e = mesh.edge_handle(h).idx();
