@@ -333,8 +333,8 @@ void order_in_space(TriMesh& mesh, std::vector<NeighbourCache>& caches) {
   std::vector<char> placed(order.size(), 0);
   for (std::size_t start = 0; start < order.size(); ++start) {
     if (placed[start]) continue;
-    NeighbourCache carried = caches[start];  // the cache of the vertex whose old index is v
     std::size_t v = start;
+    NeighbourCache carried = caches[v];  // old vertex v's cache, on its way to order[v]
     do {
       const std::size_t to = order[v];
       std::swap(carried, caches[to]);
@@ -419,7 +419,6 @@ Result equalize(TriMesh& mesh, const Params& params, const OnIteration& on_itera
     }
     const auto iteration_start = Clock::now();
     IterationStats counters;
-
     if (params.relax_every > 0 && i % params.relax_every == 0) {
       const PhaseTimer timer(phases.setup);
       reference = std::make_unique<ReferenceSurface>(mesh);
