@@ -119,7 +119,7 @@ constexpr int kExploreAfter = 2;
 /// (spatial_order.h) at the start, and after the stellar operations of an iteration once the splits
 /// and collapses since the last numbering reach kOrderShare of its vertices. Measured (Table 4.2
 /// setup, 2 threads, means over the five intervals of bench --spread): armadillo 7.46 -> 3.98 s,
-/// nefertiti 10.1 -> 6.1 s (each numbering takes ~60 ms there, 13 in its run), with the same
+/// nefertiti 10.1 -> 6.1 s (each numbering takes 30-40 ms there, 13 in its run), with the same
 /// quality within the runs' spread. A share of 0.05 gave 4.08 and 6.24 s, 0.15 4.33 and 7.01 s,
 /// every iteration 4.43 and 6.72 s; 0.02 measured again gave 4.55 and 6.72 s, so only the last two
 /// are clearly slower. Below ~16 000 vertices the mesh stays in the caches: fandisk (13 000) gained
@@ -323,24 +323,27 @@ void restore_snapshot(TriMesh& mesh, const MeshSnapshot& snapshot) {
 }
 
 /// The mesh's elements numbered in space order (spatial_order.h), each vertex's neighbour cache
-/// moved with it (in place, cycle by cycle: a second vector of caches would add 200 bytes a vertex
-/// to the run's peak); the normal attributes released again (release_normals).
-void order_in_space(TriMesh& mesh, std::vector<NeighbourCache>& caches) {
-  const std::vector<unsigned> order = spatial_order(mesh);
+/// moved with it (in place, cycle by cycle, each cache copied once: a second vector of caches would
+/// add 200 bytes a vertex to the run's peak); the normal attributes released again (release_normals).
+void order_in_space(TriMesh& mesh, std::vector<NeighbourCache>& caches, unsigned threads) {
+  const std::vector<unsigned> order = spatial_order(mesh, threads);
   release_normals(mesh);
   if (caches.empty()) return;
-  caches.resize(order.size());
-  std::vector<char> placed(order.size(), 0);
-  for (std::size_t start = 0; start < order.size(); ++start) {
-    if (placed[start]) continue;
-    std::size_t v = start;
-    NeighbourCache carried = caches[v];  // old vertex v's cache, on its way to order[v]
-    do {
-      const std::size_t to = order[v];
-      std::swap(carried, caches[to]);
-      placed[to] = 1;
-      v = to;
-    } while (v != start);
+  const std::size_t n = order.size();
+  caches.resize(n);
+  std::vector<unsigned> from(n);  // the old index of the vertex now at each index
+  for (std::size_t v = 0; v < n; ++v) from[order[v]] = static_cast<unsigned>(v);
+  for (std::size_t start = 0; start < n; ++start) {
+    if (from[start] == start) continue;
+    // Pull each cache of the cycle through `start` into place; the first goes last.
+    const NeighbourCache first = caches[start];
+    std::size_t at = start;
+    for (std::size_t source = from[at]; source != start; at = source, source = from[at]) {
+      caches[at] = caches[source];
+      from[at] = static_cast<unsigned>(at);
+    }
+    caches[at] = first;
+    from[at] = static_cast<unsigned>(at);
   }
 }
 
@@ -387,7 +390,7 @@ Result equalize(TriMesh& mesh, const Params& params, const OnIteration& on_itera
   collect_garbage(mesh);
   release_normals(mesh);
   std::vector<NeighbourCache> neighbour_caches;  // per vertex, for the projection (projection.h)
-  if (mesh.n_vertices() >= kOrderMinVertices) order_in_space(mesh, neighbour_caches);
+  if (mesh.n_vertices() >= kOrderMinVertices) order_in_space(mesh, neighbour_caches, threads);
   std::size_t renumbered_since = 0;  // splits and collapses since (kOrderShare)
   auto reference = std::make_unique<ReferenceSurface>(mesh);
   auto features = std::make_unique<FeatureSnap>(mesh, params.e_min);
@@ -435,7 +438,7 @@ Result equalize(TriMesh& mesh, const Params& params, const OnIteration& on_itera
       renumbered_since += stellar.splits + stellar.collapses;
       if (mesh.n_vertices() >= kOrderMinVertices &&
           static_cast<double>(renumbered_since) >= kOrderShare * static_cast<double>(mesh.n_vertices())) {
-        order_in_space(mesh, neighbour_caches);
+        order_in_space(mesh, neighbour_caches, threads);
         renumbered_since = 0;
       }
       counters.splits = stellar.splits;

@@ -6,6 +6,8 @@
 #include <utility>
 #include <vector>
 
+#include "core/parallel.h"
+
 namespace remesh {
 
 namespace {
@@ -23,7 +25,7 @@ std::uint64_t spread_bits(std::uint64_t x) {
 
 /// Old index of each vertex in Morton order of the positions (21 bits a coordinate over the
 /// bounding box; ties by old index).
-std::vector<unsigned> morton_order(const TriMesh& mesh) {
+std::vector<unsigned> morton_order(const TriMesh& mesh, unsigned threads) {
   const std::size_t n = mesh.n_vertices();
   constexpr double kBig = std::numeric_limits<double>::max();
   Vec3 lo(kBig, kBig, kBig), hi(-kBig, -kBig, -kBig);
@@ -32,15 +34,15 @@ std::vector<unsigned> morton_order(const TriMesh& mesh) {
   const double largest = std::max({extent[0], extent[1], extent[2]});
   const double scale = largest > 0 ? 2097151.0 / largest : 0.0;  // 2^21 - 1
   std::vector<std::pair<std::uint64_t, unsigned>> keys(n);
-  for (auto v : mesh.vertices()) {
-    const Vec3 q = (mesh.point(v) - lo) * scale;
+  parallel_for(n, threads, [&](std::size_t i) {
+    const Vec3 q = (mesh.point(mesh.vertex_handle(static_cast<unsigned>(i))) - lo) * scale;
     std::uint64_t code = 0;
     for (int k = 0; k < 3; ++k) {
       const double c = q[k] >= 0 ? std::min(q[k], 2097151.0) : 0.0;  // (a NaN goes to 0)
       code |= spread_bits(static_cast<std::uint64_t>(c)) << k;
     }
-    keys[v.idx()] = {code, static_cast<unsigned>(v.idx())};
-  }
+    keys[i] = {code, static_cast<unsigned>(i)};
+  });
   std::sort(keys.begin(), keys.end());
   std::vector<unsigned> order(n);
   for (std::size_t i = 0; i < n; ++i) order[i] = keys[i].second;
@@ -62,20 +64,21 @@ struct Numbered {
 
 /// Vertices along the curve; faces by their lowest new corner (ties: old order); edges as the faces
 /// in their new order first use them.
-Numbered numbered(const TriMesh& mesh) {
+Numbered numbered(const TriMesh& mesh, unsigned threads) {
   const std::size_t nv = mesh.n_vertices(), ne = mesh.n_edges(), nf = mesh.n_faces();
   constexpr unsigned kNone = Numbered::kNone;
   Numbered out;
-  const std::vector<unsigned> vertex_order = morton_order(mesh);
+  const std::vector<unsigned> vertex_order = morton_order(mesh, threads);
   std::vector<unsigned>& new_vertex = out.new_vertex;
   new_vertex.resize(nv);
   for (std::size_t i = 0; i < nv; ++i) new_vertex[vertex_order[i]] = static_cast<unsigned>(i);
   // Faces by a counting sort on their lowest corner, stable in their old order.
   std::vector<unsigned> lowest(nf, kNone), face_order(nf), first(nv + 1, 0);
-  for (auto f : mesh.faces()) {
-    for (auto v : mesh.fv_range(f)) lowest[f.idx()] = std::min(lowest[f.idx()], new_vertex[v.idx()]);
-    ++first[lowest[f.idx()] + 1];
-  }
+  parallel_for(nf, threads, [&](std::size_t f) {
+    for (auto v : mesh.fv_range(mesh.face_handle(static_cast<unsigned>(f))))
+      lowest[f] = std::min(lowest[f], new_vertex[v.idx()]);
+  });
+  for (unsigned l : lowest) ++first[l + 1];
   for (std::size_t v = 0; v < nv; ++v) first[v + 1] += first[v];
   for (std::size_t f = 0; f < nf; ++f) face_order[first[lowest[f]]++] = static_cast<unsigned>(f);
   std::vector<unsigned> new_face(nf), new_edge(ne, kNone);
@@ -93,27 +96,33 @@ Numbered numbered(const TriMesh& mesh) {
   auto renumbered = [&](OpenMesh::HalfedgeHandle h) {
     return static_cast<unsigned>(2 * new_edge[h.idx() / 2] + (h.idx() & 1));
   };
+  // Each loop writes each element once, at its new index.
   out.halfedges.resize(2 * ne);
-  for (auto h : mesh.halfedges()) {
+  parallel_for(2 * ne, threads, [&](std::size_t i) {
+    const OpenMesh::HalfedgeHandle h(static_cast<int>(i));
     const auto f = mesh.face_handle(h);
     out.halfedges[renumbered(h)] = {renumbered(mesh.next_halfedge_handle(h)),
                                     f.is_valid() ? new_face[f.idx()] : kNone,
                                     new_vertex[mesh.to_vertex_handle(h).idx()]};
-  }
+  });
   out.face_halfedge.resize(nf);
-  for (auto f : mesh.faces()) out.face_halfedge[new_face[f.idx()]] = renumbered(mesh.halfedge_handle(f));
+  parallel_for(nf, threads, [&](std::size_t f) {
+    out.face_halfedge[new_face[f]] = renumbered(mesh.halfedge_handle(mesh.face_handle(static_cast<unsigned>(f))));
+  });
   out.vertex_halfedge.assign(nv, kNone);
-  for (auto v : mesh.vertices())
-    if (const auto h = mesh.halfedge_handle(v); h.is_valid()) out.vertex_halfedge[new_vertex[v.idx()]] = renumbered(h);
   out.points.resize(nv);
-  for (std::size_t i = 0; i < nv; ++i) out.points[i] = mesh.point(mesh.vertex_handle(vertex_order[i]));
+  parallel_for(nv, threads, [&](std::size_t i) {
+    const auto v = mesh.vertex_handle(vertex_order[i]);
+    if (const auto h = mesh.halfedge_handle(v); h.is_valid()) out.vertex_halfedge[i] = renumbered(h);
+    out.points[i] = mesh.point(v);
+  });
   return out;
 }
 
 }  // namespace
 
-std::vector<unsigned> spatial_order(TriMesh& mesh) {
-  Numbered plain = numbered(mesh);
+std::vector<unsigned> spatial_order(TriMesh& mesh, unsigned threads) {
+  Numbered plain = numbered(mesh, threads);
   mesh = TriMesh();  // freed before the new one is built
   const std::size_t nv = plain.points.size(), ne = plain.halfedges.size() / 2, nf = plain.face_halfedge.size();
   mesh.reserve(nv, ne, nf);

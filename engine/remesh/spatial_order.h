@@ -19,7 +19,8 @@ namespace remesh {
 /// faces by their lowest new corner, and the edges in the order the faces first use them. The mesh
 /// stays the same mesh: the same faces, each halfedge's direction, each vertex's first outgoing
 /// halfedge (so every circulation starts and runs as before). Returns the new index of each vertex.
-/// Precondition: no deleted elements (collect_garbage).
-std::vector<unsigned> spatial_order(TriMesh& mesh);
+/// Precondition: no deleted elements (collect_garbage). The same result whatever `threads` (its
+/// loops write each element once; the sorts are serial).
+std::vector<unsigned> spatial_order(TriMesh& mesh, unsigned threads = 1);
 
 }  // namespace remesh
