@@ -92,6 +92,7 @@ TEST_CASE("spatial order numbers the same mesh anew, neighbours nearer in memory
       const long euler = test::euler_characteristic(mesh);
       const std::size_t loops = test::count_boundary_loops(mesh);
       const double gap_before = mean_index_gap(mesh);
+      TriMesh copy = mesh;
 
       const std::vector<unsigned> order = spatial_order(mesh);
 
@@ -108,6 +109,14 @@ TEST_CASE("spatial order numbers the same mesh anew, neighbours nearer in memory
       CHECK(test::count_boundary_loops(mesh) == loops);
       // The splits scattered the new vertices; in space order an edge's ends lie close in memory.
       CHECK(mean_index_gap(mesh) < 0.25 * gap_before);
+      // Its parallel loops give the same numbering on two threads.
+      CHECK(spatial_order(copy, 2) == order);
+      for (auto e : mesh.edges()) {
+        const OpenMesh::HalfedgeHandle h = mesh.halfedge_handle(e, 0), g = copy.halfedge_handle(copy.edge_handle(e.idx()), 0);
+        CHECK(mesh.to_vertex_handle(h) == copy.to_vertex_handle(g));
+        CHECK(mesh.next_halfedge_handle(h) == copy.next_halfedge_handle(g));
+        CHECK(mesh.face_handle(h) == copy.face_handle(g));
+      }
     }
   }
 }
