@@ -57,7 +57,8 @@ const char* outcome_name(Outcome o);
 /// (the benchmark, the CLI and the job document show them). Statistics rows, snapshots of the best
 /// mesh so far and the thin-part count make up the rest of Result::seconds.
 struct PhaseSeconds {
-  double stellar = 0;     ///< priority list, stellar operations, garbage collection (Alg. 2, 3)
+  double stellar = 0;     ///< priority list, stellar operations, garbage collection (Alg. 2, 3), and
+                          ///< the numbering in space order of a large mesh after them (spatial_order.h)
   double flips = 0;       ///< valence flips (Alg. 4) and look-ahead flips (regularize.h)
   double filter = 0;      ///< low-pass filter (Alg. 5)
   double projection = 0;  ///< projection onto the reference (Alg. 6)
@@ -65,7 +66,8 @@ struct PhaseSeconds {
   double cleanup = 0;     ///< interval cleanups: the iterations', the final one, the untangling's mends
   double snap = 0;        ///< feature snap (feature_snap.h)
   double untangle = 0;    ///< moving crossing faces apart (untangle.h), its mends not included
-  double setup = 0;       ///< reference surface, its kd-tree and feature points (and again at each `pr`)
+  double setup = 0;       ///< reference surface, its kd-tree and feature points (and again at each `pr`),
+                          ///< and the first numbering in space order of a large input
   double sum() const;  ///< of every step (kPhaseFields)
 };
 
