@@ -58,6 +58,9 @@ class FeatureSnap {
   std::size_t pass(TriMesh& mesh, const ReferenceSurface& reference, double e_min, double e_max, unsigned threads,
                    std::size_t& budget) const;
 
+  /// apply()'s budget of patch relaxations for a mesh of `vertices` vertices.
+  static std::size_t budget_for(std::size_t vertices);
+
   std::size_t size() const { return points_.size(); }
 
  private:

@@ -222,8 +222,8 @@ TEST_CASE("the snap's passes, measuring again only near what moved, equal passes
     const FeatureSnap features(reference);
     TriMesh carried = mesh, fresh = mesh;
     const std::size_t kept = features.apply(carried, surface, 1.2, 1.8, 2);
-    // apply()'s budget and passes (feature_snap.cpp: kSnapBudgetMin, kSnapPasses), pass by pass.
-    std::size_t budget = std::max<std::size_t>(16, fresh.n_vertices() / 50), kept_fresh = 0;
+    // apply()'s budget and passes (feature_snap.cpp: kSnapPasses), pass by pass.
+    std::size_t budget = FeatureSnap::budget_for(fresh.n_vertices()), kept_fresh = 0;
     for (int i = 0; i < 3; ++i) {
       const std::size_t n = features.pass(fresh, surface, 1.2, 1.8, 2, budget);
       kept_fresh += n;
