@@ -23,8 +23,8 @@ MeshSnapshot::MeshSnapshot(const TriMesh& mesh) {
   }
 }
 
-TriMesh MeshSnapshot::rebuild() const {
-  TriMesh mesh;
+void MeshSnapshot::rebuild(TriMesh& mesh) const {
+  free_mesh(mesh);
   mesh.reserve(points_.size(), faces_.size() * 3 / 2 + 3, faces_.size());
   for (const Vec3& p : points_) mesh.add_vertex(p);
   for (const auto& t : faces_) {
@@ -32,7 +32,6 @@ TriMesh MeshSnapshot::rebuild() const {
     // The faces came from a valid mesh, so this cannot happen; say so if it ever does.
     if (!f.is_valid()) throw std::logic_error("a mesh snapshot could not be rebuilt");
   }
-  return mesh;
 }
 
 }  // namespace remesh

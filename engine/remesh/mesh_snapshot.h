@@ -16,9 +16,10 @@ class MeshSnapshot {
  public:
   explicit MeshSnapshot(const TriMesh& mesh);
 
-  /// The mesh again: its live vertices in their order (renumbered past deleted ones) and its faces
+  /// The mesh again, built into `mesh` (whose own elements are freed first: a run's peak holds one
+  /// mesh, not two): its live vertices in their order (renumbered past deleted ones) and its faces
   /// in their order, corners as they were.
-  TriMesh rebuild() const;
+  void rebuild(TriMesh& mesh) const;
 
  private:
   std::vector<Vec3> points_;

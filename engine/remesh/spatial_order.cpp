@@ -123,7 +123,7 @@ Numbered numbered(const TriMesh& mesh, unsigned threads) {
 
 std::vector<unsigned> spatial_order(TriMesh& mesh, unsigned threads) {
   Numbered plain = numbered(mesh, threads);
-  mesh = TriMesh();  // freed before the new one is built
+  free_mesh(mesh);  // before the new one is built
   const std::size_t nv = plain.points.size(), ne = plain.halfedges.size() / 2, nf = plain.face_halfedge.size();
   mesh.reserve(nv, ne, nf);
   for (const Vec3& p : plain.points) mesh.add_vertex(p);
