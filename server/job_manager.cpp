@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <utility>
 
 #include "job_runner.h"
 
@@ -202,7 +203,8 @@ void JobManager::run(const std::string& id) {
       job->record.iteration = row.iteration;
       changed_.notify_all();
     };
-    RunOutput out = run_job(record, upload, config_.engine_threads, on_iteration, token);
+    auto write = [&](const std::string& name, std::string_view bytes) { store_.write_file(id, name, bytes); };
+    RunOutput out = run_job(record, std::move(upload), config_.engine_threads, on_iteration, token, write);
     if (out.outcome == remesh::Outcome::Cancelled) {
       {
         std::lock_guard lock(mutex_);
@@ -211,7 +213,6 @@ void JobManager::run(const std::string& id) {
       finish(JobState::Cancelled);
       return;
     }
-    for (const auto& [name, bytes] : out.files) store_.write_file(id, name, bytes);
     {
       std::lock_guard lock(mutex_);
       job->record.outcome = std::string(remesh::api::outcome_name(out.outcome));

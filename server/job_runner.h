@@ -3,7 +3,7 @@
 /// The engine work of one job, free of threads and HTTP: read the stored upload, remesh, and
 /// serialise the remeshed mesh and its trivalent dual in every download format.
 
-#include <map>
+#include <functional>
 #include <stop_token>
 #include <string>
 #include <string_view>
@@ -19,14 +19,19 @@ struct RunOutput {
   remesh::ThinParts thin;  ///< Result::thin
   remesh::PhaseSeconds phases;  ///< Result::phases
   double seconds = 0;           ///< Result::seconds
-  /// File name ("remeshed.obj", "dual.glb", ...) -> bytes; empty when cancelled.
-  std::map<std::string, std::string> files;
 };
 
-/// Runs the job described by `job` on `upload`. `threads` engine threads (0 = all cores).
-/// Throws whatever the engine throws (the caller marks the job failed with the message).
-RunOutput run_job(const remesh::api::JobRecord& job, std::string_view upload, unsigned threads,
-                  const remesh::OnIteration& on_iteration, std::stop_token stop);
+/// Receives each result file as soon as it is serialised: its name ("remeshed.obj", "dual.glb",
+/// ...) and bytes, which it must not keep (they are freed when it returns).
+using FileSink = std::function<void(const std::string& name, std::string_view bytes)>;
+
+/// Runs the job described by `job` on `upload`, which is freed once read (an upload of up to the
+/// service's 256 MB limit is not held through the run). `threads` engine threads (0 = all cores).
+/// Unless the run is cancelled, the remeshed mesh and its dual go to `write` in every download
+/// format, one file at a time (so the run's peak holds one serialised file, not ten).
+/// Throws whatever the engine or `write` throws (the caller marks the job failed with the message).
+RunOutput run_job(const remesh::api::JobRecord& job, std::string upload, unsigned threads,
+                  const remesh::OnIteration& on_iteration, std::stop_token stop, const FileSink& write);
 
 /// The validated input (read as the job read it) in `format` ("obj", "glb", ...).
 std::string convert_input(const remesh::api::JobRecord& job, std::string_view upload, const std::string& format);

@@ -3,13 +3,20 @@
 
 #include <cstdlib>
 #include <fstream>
+#include <map>
 #include <random>
+#include <set>
+#include <stop_token>
+#include <string>
 
+#include "io/mesh_io.h"
+#include "job_runner.h"
 #include "job_store.h"
 #include "options.h"
 #include "routes.h"
 #include "sse.h"
 #include "static_files.h"
+#include "support/mesh_generators.h"
 
 using namespace remeshd;
 namespace fs = std::filesystem;
@@ -155,4 +162,49 @@ TEST_CASE("JobStore: atomic job directories, torn stats lines, bad ids", "[serve
   std::vector<std::string> problems;
   CHECK(again.load_all(problems).size() == 1);
   fs::remove_all(root);
+}
+
+TEST_CASE("run_job hands each result file to the sink once, and none when cancelled", "[server][runner]") {
+  // A small sphere, written as an OFF upload, remeshed to an interval around its edge length.
+  const remesh::TriMesh sphere = remesh::test::make_icosphere(2, 10.0);
+  double total = 0;
+  for (auto e : sphere.edges()) total += sphere.calc_edge_length(e);
+  const double mean = total / static_cast<double>(sphere.n_edges());
+  remesh::api::JobRecord job;
+  job.id = "0123456789abcdef0123456789abcdef";
+  job.format = "off";
+  job.params.e_min = 0.8 * mean;
+  job.params.e_max = 1.2 * mean;
+  job.params.iterations = 5;
+  const std::string upload = remesh::write_mesh(sphere, remesh::Format::Off);
+
+  std::map<std::string, std::string> files;
+  auto sink = [&](const std::string& name, std::string_view bytes) {
+    CHECK(files.count(name) == 0);
+    files[name] = std::string(bytes);
+  };
+  const RunOutput out = run_job(job, upload, 1, {}, std::stop_token{}, sink);
+  CHECK(out.outcome != remesh::Outcome::Cancelled);
+  std::set<std::string> expected;
+  for (const auto& f : remesh::api::remeshed_formats()) expected.insert("remeshed." + f);
+  for (const auto& f : remesh::api::dual_formats()) expected.insert("dual." + f);
+  std::set<std::string> got;
+  for (const auto& [name, bytes] : files) {
+    got.insert(name);
+    CHECK(!bytes.empty());
+  }
+  CHECK(got == expected);
+  // The files are the results: the remeshed OFF reads back as a closed mesh like the sphere.
+  const remesh::LoadedMesh back = remesh::read_mesh(files.at("remeshed.off"), {remesh::Format::Off});
+  CHECK(back.mesh.n_faces() > 0);
+  CHECK(static_cast<long>(back.mesh.n_vertices()) - static_cast<long>(back.mesh.n_edges()) +
+            static_cast<long>(back.mesh.n_faces()) == 2);
+
+  std::stop_source stopped;
+  stopped.request_stop();
+  std::size_t calls = 0;
+  const RunOutput cancelled = run_job(job, upload, 1, {}, stopped.get_token(),
+                                      [&](const std::string&, std::string_view) { ++calls; });
+  CHECK(cancelled.outcome == remesh::Outcome::Cancelled);
+  CHECK(calls == 0);
 }
