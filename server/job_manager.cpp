@@ -1,5 +1,9 @@
 #include "job_manager.h"
 
+#ifdef __GLIBC__
+#include <malloc.h>
+#endif
+
 #include <algorithm>
 #include <chrono>
 #include <utility>
@@ -161,6 +165,11 @@ void JobManager::worker_loop() {
       queue_.pop_front();
     }
     run(id);
+#ifdef __GLIBC__
+    // The job's memory back to the system, not only to malloc: an idle daemon holds ~20 MB
+    // instead of the last job's ~90 (nefertiti, Table 4.2 setup).
+    malloc_trim(0);
+#endif
   }
 }
 

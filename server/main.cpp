@@ -2,6 +2,9 @@
 // the HTTP server, and shuts down cleanly on SIGTERM/SIGINT (running jobs stay re-queueable).
 #include <pthread.h>
 #include <signal.h>
+#ifdef __GLIBC__
+#include <malloc.h>
+#endif
 
 #include <cstdio>
 #include <thread>
@@ -23,6 +26,15 @@ int main(int argc, char** argv) {
   }
   const Options& o = *parsed.options;
   Logger log(o.log_format == "json");
+#ifdef __GLIBC__
+  // One malloc arena for every thread, set before any starts. With glibc's default (one per thread
+  // that contends, up to 8 per core), memory a job freed stayed in its threads' arenas, unused by
+  // the next job's: the daemon's resident memory grew job after job (nefertiti jobs one after
+  // another on one worker: 121, 160, 199 MB after the first three, 321 MB after six). With one
+  // arena it stays at 88-98 MB, and the jobs take the same time (5.6-5.8 s each; with 2 workers,
+  // 8.6-9.2 s each either way: the engine allocates per phase, not per element).
+  mallopt(M_ARENA_MAX, 1);
+#endif
 
   // Signals are taken by one thread (sigwait); every other thread blocks them.
   sigset_t signals;

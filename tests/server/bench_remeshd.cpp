@@ -1,7 +1,9 @@
 // Benchmark (not a test): with 2 jobs running on 2 workers and 64 SSE clients connected, measures
 //   - SSE delivery delay: from an iteration's row being stored (stats.jsonl grows; polled every
 //     0.5 ms) to each client receiving the event;
-//   - /healthz latency percentiles, polled every 20 ms meanwhile.
+//   - /healthz latency percentiles, polled every 20 ms meanwhile;
+//   - the daemon's resident memory (VmRSS, VmHWM) after those jobs and after each of 4 more run
+//     one after another (does it hold what the jobs freed?).
 // usage: bench_remeshd [clients=64] [subdiv=4] [iterations=40]
 #include <algorithm>
 #include <cstdlib>
@@ -133,5 +135,28 @@ int main(int argc, char** argv) {
   std::printf("  /healthz latency, %zu requests (%d failed): p50 %.2f ms  p90 %.2f ms  p99 %.2f ms  max %.2f ms\n",
               health.size(), health_failed, percentile(health, 50), percentile(health, 90), percentile(health, 99),
               percentile(health, 100));
+  auto memory = [&] {  // "resident X MB (peak Y MB)" from /proc/<pid>/status
+    std::ifstream in("/proc/" + std::to_string(d.pid()) + "/status");
+    std::string line, rss = "?", hwm = "?";
+    while (std::getline(in, line)) {
+      auto kb = [&] { return std::to_string(std::atol(line.c_str() + line.find_first_of("0123456789")) / 1024); };
+      if (line.rfind("VmRSS:", 0) == 0) rss = kb();
+      if (line.rfind("VmHWM:", 0) == 0) hwm = kb();
+    }
+    return "resident " + rss + " MB (peak " + hwm + " MB)";
+  };
+  for (const auto& id : ids) wait_final(c, id, 600);
+  std::printf("  after the 2 jobs: %s\n", memory().c_str());
+  std::printf("  4 more, one after another, after each:");
+  for (int i = 0; i < 4; ++i) {
+    auto r = submit_raw(c, sphere_obj(subdiv), query);
+    if (!r || r->status != 202) {
+      std::fprintf(stderr, "submit failed\n");
+      return 1;
+    }
+    wait_final(c, json::parse(r->body)["id"], 600);
+    std::printf("%s %s", i ? ";" : "", memory().c_str());
+  }
+  std::printf("\n");
   return 0;
 }

@@ -31,6 +31,7 @@ class Daemon {
   ~Daemon();  ///< SIGTERM, then SIGKILL after 10 s
 
   int port() const { return port_; }
+  int pid() const { return pid_; }
   /// A client for the daemon (timeouts 30 s); `token` sets the bearer header.
   httplib::Client client(const std::string& token = "") const;
   /// Sends `sig` and waits for the process; returns its exit status (or 128 + signal).
