@@ -4,6 +4,7 @@
 #include <malloc.h>
 
 #include <cstddef>
+#include <vector>
 
 #include "core/mesh.h"
 #include "support/mesh_generators.h"
