@@ -22,6 +22,7 @@ double equalizing_parameter(const Vec3& a, const Vec3& b, const std::vector<Vec3
   int best = kSamples / 2;
   double best_e = equalization_energy(a, b, 0.5, neighbours, target);
   for (int i = 0; i <= kSamples; ++i) {
+    if (i == kSamples / 2) continue;  // t = 0.5, measured above
     const double e = equalization_energy(a, b, double(i) / kSamples, neighbours, target);
     if (e < best_e) best_e = e, best = i;
   }
