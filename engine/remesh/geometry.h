@@ -3,10 +3,34 @@
 /// Small geometric helpers shared by the steps: angles, closest point on a triangle, normals and the
 /// fold / degeneracy tests every mesh edit must pass.
 
+#include <algorithm>
+#include <limits>
 #include <utility>
 #include <vector>
 
 #include "core/mesh.h"
+
+namespace remesh {
+
+/// An axis-aligned box; empty (lo above hi) until a point is added.
+struct Box {
+  Vec3 lo{std::numeric_limits<double>::infinity()}, hi{-std::numeric_limits<double>::infinity()};
+  void add(const Vec3& p) { lo.minimize(p), hi.maximize(p); }
+  bool contains(const Vec3& q) const {
+    return q[0] >= lo[0] && q[0] <= hi[0] && q[1] >= lo[1] && q[1] <= hi[1] && q[2] >= lo[2] && q[2] <= hi[2];
+  }
+  /// Squared distance from q to the box (0 inside).
+  double squared_distance(const Vec3& q) const {
+    double d = 0;
+    for (int a = 0; a < 3; ++a) {
+      const double out = std::max({lo[a] - q[a], 0.0, q[a] - hi[a]});
+      d += out * out;
+    }
+    return d;
+  }
+};
+
+}  // namespace remesh
 
 namespace remesh::geom {
 

@@ -38,26 +38,23 @@ class GapJudge {
       : faces_(std::move(faces)), target_(target) {
     target_before_ = nearest_distance(mesh, target);
     // A point within e_min of a face lies in the faces' bounding box grown by e_min, and in the
-    // sphere around that box: only the points in both are measured against every face (cheese, whose
-    // reference is dense along its holes' rims, has ~1 000 points within `reach` of a target).
+    // sphere around that box: only the points in both are measured (cheese, whose reference is
+    // dense along its holes' rims, has ~1 000 points within `reach` of a target), and each only
+    // against the faces whose own box is within e_min, or the best distance so far.
+    std::vector<Box> boxes(faces_.size());
     Box all;
-    for (auto f : faces_)
-      for (auto v : mesh.fv_range(f)) all.add(mesh.point(v));
+    for (std::size_t k = 0; k < faces_.size(); ++k)
+      for (auto v : mesh.fv_range(faces_[k])) boxes[k].add(mesh.point(v)), all.add(mesh.point(v));
     const double grow = e_min * (1 + 1e-9);  // a little wider, for the arithmetic's last bit
-    const Vec3 lo = all.lo - Vec3(grow), hi = all.hi + Vec3(grow);
-    const Vec3 centre = 0.5 * (lo + hi);
-    const double radius = std::min(reach, 0.5 * (hi - lo).norm());
+    const Box grown{all.lo - Vec3(grow), all.hi + Vec3(grow)};
+    const Vec3 centre = 0.5 * (grown.lo + grown.hi);
+    const double radius = std::min(reach, 0.5 * (grown.hi - grown.lo).norm());
     // The index's test, in its own arithmetic, could differ in the last bit: ask a little wider.
     std::vector<std::uint32_t> near;
     if (!faces_.empty()) points.within(centre, radius * (1 + 1e-9), near);
-    if (near.empty()) return;
-    // Each face's box, to pass over the faces that cannot be nearer than e_min or the best so far.
-    std::vector<Box> boxes(faces_.size());
-    for (std::size_t k = 0; k < faces_.size(); ++k)
-      for (auto v : mesh.fv_range(faces_[k])) boxes[k].add(mesh.point(v));
     for (std::uint32_t i : near) {
       const Vec3& q = points.points()[i];
-      if (!Box{lo, hi}.contains(q) || q == target || !((q - target).sqrnorm() < reach * reach)) continue;
+      if (!grown.contains(q) || q == target || !((q - target).sqrnorm() < reach * reach)) continue;
       // The nearest face, among those whose box is within e_min (ties to the first, as nearest()).
       std::pair<double, OpenMesh::FaceHandle> best{e_min, OpenMesh::FaceHandle()};
       for (std::size_t k = 0; k < faces_.size(); ++k)
@@ -98,23 +95,6 @@ class GapJudge {
     return best;
   }
   double nearest_distance(const TriMesh& mesh, const Vec3& q) const { return nearest(mesh, q).first; }
-
-  /// An axis-aligned box (empty until a point is added).
-  struct Box {
-    Vec3 lo{std::numeric_limits<double>::infinity()}, hi{-std::numeric_limits<double>::infinity()};
-    void add(const Vec3& p) { lo.minimize(p), hi.maximize(p); }
-    bool contains(const Vec3& q) const {
-      return q[0] >= lo[0] && q[0] <= hi[0] && q[1] >= lo[1] && q[1] <= hi[1] && q[2] >= lo[2] && q[2] <= hi[2];
-    }
-    double squared_distance(const Vec3& q) const {
-      double d = 0;
-      for (int a = 0; a < 3; ++a) {
-        const double out = std::max({lo[a] - q[a], 0.0, q[a] - hi[a]});
-        d += out * out;
-      }
-      return d;
-    }
-  };
 
   std::vector<OpenMesh::FaceHandle> faces_;
   Vec3 target_;

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "core/mesh.h"
+#include "remesh/geometry.h"  // Box
 
 namespace remesh {
 
@@ -44,11 +45,6 @@ struct FaceSpheres {
   double largest = 0;  ///< the largest radius
 };
 FaceSpheres face_spheres(const TriMesh& mesh);
-
-/// An axis-aligned box.
-struct Box {
-  Vec3 lo, hi;
-};
 
 /// Does the sphere (centre, radius) meet `box` grown by `grow` on every side?
 bool sphere_meets(const Box& box, const Vec3& centre, double radius, double grow = 0);

@@ -431,11 +431,9 @@ class Untangler {
 
   /// Grows the box of the moves since the last refresh() by a move from a to b.
   void note_move(const Vec3& a, const Vec3& b) {
-    if (!moved_) moves_ = Box{a, a}, moved_ = true;
-    for (const Vec3& p : {a, b}) {
-      moves_.lo.minimize(p);
-      moves_.hi.maximize(p);
-    }
+    if (!moved_) moves_ = Box{}, moved_ = true;
+    moves_.add(a);
+    moves_.add(b);
   }
 
   /// Indexes the faces' bounding spheres as the mesh holds them now.
