@@ -268,6 +268,20 @@ TEST_CASE("a strong simplification starts the cleanup only once its edge count s
   }
 }
 
+TEST_CASE("a target ten times the input's mean edge is reached", "[equalize]") {
+  // Mean edge 0.15 -> [1.2, 1.8]: with the thesis' band m_i +- sigma the first intermediate target
+  // (twice the mean, 0.3) minus sigma (0.3) is 0, nothing is short and the run stalls with the
+  // input unchanged; the band is capped at m_i / 2 (band_at in equalize.cpp).
+  for (auto mesh : {test::make_icosphere(5, 10.0), test::make_torus(160, 64, 12.0, 4.0)}) {
+    test::scale_mean_edge(mesh, 0.15);
+    const std::size_t before = mesh.n_vertices();
+    remesh_and_check(mesh, table_4_2(100));
+    INFO("vertices " << before << " -> " << mesh.n_vertices());
+    CHECK(mesh.n_vertices() * 50 < before);  // about 100x fewer: (1.5 / 0.15)^2
+    CHECK(test::plain_inside_fraction(mesh, 1.2, 1.8) >= 0.99);
+  }
+}
+
 TEST_CASE("the returned mesh's normals are those of its faces", "[equalize]") {
   // A converged run (the mesh of the last iteration) and a stalled one (the mesh of its low, rebuilt
   // from a snapshot), refined and simplified.
