@@ -267,11 +267,33 @@ class Cleanup {
   }
 
   bool try_collapse(EdgeHandle e) {
+    if (!ring_can_fit(e)) return false;
     if (collapse_at(e, e_max_, false)) return true;
     // The eq. 3.1 point leaves an edge outside (typically a valence-4 vertex among short edges:
     // merging it with a neighbour makes the far corner of its star too far). Plan again with the
     // main phase's looser length bound and place the merged vertex freely in its tangent plane.
     return collapse_at(e, 2.0 * e_max_, true);
+  }
+
+  /// Could one point lie within e_max of every vertex around e? collapse_at keeps a collapse only
+  /// if each edge of the merged vertex is inside the interval, so then every two of those vertices
+  /// lie within 2 e_max of each other. Tested on the ring alone, before the collapse is planned (eq.
+  /// 3.1) and projected. The same meshes (the 14 small Table 4.1/4.2 runs, byte for byte); in a
+  /// tight interval, where almost every collapse fails so, the cleanup takes a third less time
+  /// (kitten at [1.425, 1.575]: 30.6 -> 21.3 s; cheese refined 1.58 -> 1.38 s in all).
+  bool ring_can_fit(EdgeHandle e) {
+    const HalfedgeHandle h = mesh_.halfedge_handle(e, 0);
+    const VertexHandle v0 = mesh_.from_vertex_handle(h), v1 = mesh_.to_vertex_handle(h);
+    std::vector<Vec3>& ring = ring_;
+    ring.clear();
+    for (VertexHandle end : {v0, v1})
+      for (auto w : mesh_.vv_range(end))
+        if (w != v0 && w != v1) ring.push_back(mesh_.point(w));  // a shared neighbour twice: harmless
+    const double reach = 2 * e_max_ * (1 + 1e-9);  // a hair wide, for the rounding of the lengths
+    for (std::size_t i = 0; i < ring.size(); ++i)
+      for (std::size_t j = i + 1; j < ring.size(); ++j)
+        if ((ring[i] - ring[j]).sqrnorm() > reach * reach) return false;
+    return true;
   }
 
   bool collapse_at(EdgeHandle e, double plan_limit, bool free_placement) {
