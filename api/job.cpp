@@ -139,7 +139,8 @@ json job_to_json(const JobRecord& job, std::string_view prefix, double now) {
       {"outcome", job.outcome ? json(*job.outcome) : json(nullptr)},
       {"thin_parts", job.thin_parts ? json{{"outside", job.thin_parts->outside},
                                            {"in_thin_parts", job.thin_parts->in_thin_parts},
-                                           {"limit", job.thin_parts->limit}}
+                                           {"limit", job.thin_parts->limit},
+                                           {"at_irregular_vertices", job.thin_parts->at_irregular}}
                                      : json(nullptr)},
       {"seconds_by_step", job.seconds_by_step ? step_seconds_to_json(*job.seconds_by_step) : json(nullptr)},
       {"error", job.error ? json(*job.error) : json(nullptr)},
@@ -175,9 +176,12 @@ JobRecord job_from_json(const json& j) {
     if (!j.at("latest").is_null()) job.latest = j.at("latest").get<IterationStats>();
     if (!j.at("outcome").is_null()) job.outcome = j.at("outcome").get<std::string>();
     // Absent in documents written before the field existed.
-    if (const auto t = j.find("thin_parts"); t != j.end() && !t->is_null())
+    if (const auto t = j.find("thin_parts"); t != j.end() && !t->is_null()) {
       job.thin_parts = ThinParts{t->at("outside").get<std::size_t>(), t->at("in_thin_parts").get<std::size_t>(),
                                  t->at("limit").get<double>()};
+      // Absent in documents written before the count existed: 0 there.
+      job.thin_parts->at_irregular = t->value("at_irregular_vertices", std::size_t{0});
+    }
     if (const auto t = j.find("seconds_by_step"); t != j.end() && !t->is_null())
       job.seconds_by_step = step_seconds_from_json(*t);
     if (!j.at("error").is_null()) job.error = j.at("error").get<std::string>();

@@ -114,6 +114,10 @@ void print_final(const TriMesh& mesh, const Job& job, const Result& result) {
     std::printf("  in thin parts:        %zu of the %zu edges outside (the input is thinner than %g = 2 e_min / "
                 "sqrt(3) there: too thin for edges in the interval)\n",
                 result.thin.in_thin_parts, result.thin.outside, result.thin.limit);
+  if (result.thin.outside > 0)
+    std::printf("  irregular valence:    %zu of the %zu edges outside (an end of valence other than 6, or 4 on the "
+                "boundary: a 5-7 pair strains the edges around it by 10-15 %%, more than a tight interval allows)\n",
+                result.thin.at_irregular, result.thin.outside);
   std::printf("  regular vertices:     %.2f %%\n", q.regular_percent);
   std::printf("  edge length:          mean %.6g, deviation %.4g, min %.6g, max %.6g\n", q.mean, q.deviation,
               s.min_edge, s.max_edge);

@@ -73,6 +73,7 @@ TEST_CASE("job document: fields, links only when succeeded, round trip", "[api][
   r.latest = last;
   r.iteration = 9;
   r.thin_parts = ThinParts{12, 7, 1.25};
+  r.thin_parts->at_irregular = 5;
   PhaseSeconds phases;
   phases.stellar = 0.5, phases.projection = 0.25, phases.untangle = 0.125;
   r.seconds_by_step = JobRecord::StepSeconds{phases, 1.0};
@@ -86,6 +87,7 @@ TEST_CASE("job document: fields, links only when succeeded, round trip", "[api][
   CHECK(doc["thin_parts"]["outside"] == 12);
   CHECK(doc["thin_parts"]["in_thin_parts"] == 7);
   CHECK(doc["thin_parts"]["limit"] == 1.25);
+  CHECK(doc["thin_parts"]["at_irregular_vertices"] == 5);
   CHECK(doc["timings"]["queued_seconds"] == Approx(1.0));
   CHECK(doc["timings"]["run_seconds"] == Approx(3.0));
   REQUIRE(doc["links"].contains("results"));
@@ -104,6 +106,16 @@ TEST_CASE("job document: fields, links only when succeeded, round trip", "[api][
   CHECK(back.thin_parts->outside == 12);
   CHECK(back.thin_parts->in_thin_parts == 7);
   CHECK(back.thin_parts->limit == 1.25);
+  CHECK(back.thin_parts->at_irregular == 5);
+  {
+    // A record written before the count existed reads with 0.
+    json old = doc;
+    old["thin_parts"].erase("at_irregular_vertices");
+    const JobRecord before = job_from_json(old);
+    REQUIRE(before.thin_parts);
+    CHECK(before.thin_parts->in_thin_parts == 7);
+    CHECK(before.thin_parts->at_irregular == 0);
+  }
   REQUIRE(back.seconds_by_step);
   CHECK(back.seconds_by_step->steps.stellar == 0.5);
   CHECK(back.seconds_by_step->steps.untangle == 0.125);

@@ -308,12 +308,21 @@ TEST_CASE("the summary says how many edges outside lie in parts too thin for the
   line >> thin >> of >> the >> outside;
   CHECK(thin > 0);
   CHECK(thin == outside);
+  // And how many of them have an end of irregular valence: "M of the N edges outside".
+  const auto irregular_at = r.out.find("irregular valence:");
+  REQUIRE(irregular_at != std::string::npos);
+  std::istringstream irregular_line(r.out.substr(irregular_at + std::string("irregular valence:").size()));
+  std::size_t irregular = 0, outside_again = 0;
+  irregular_line >> irregular >> of >> the >> outside_again;
+  CHECK(outside_again == outside);
+  CHECK(irregular <= outside);
   // A sphere whose edges all fit has no such line.
   write_obj(remesh::test::make_icosphere(3, 4.0), dir.file("sphere.obj"));
   const ProcessResult s = remesh_cli({dir.file("sphere.obj"), dir.file("out2.obj"), "--emin", "1.2", "--emax", "1.8"});
   REQUIRE(s.exit_code == 0);
   CHECK(s.out.find("100.000 %") != std::string::npos);
   CHECK(s.out.find("in thin parts") == std::string::npos);
+  CHECK(s.out.find("irregular valence") == std::string::npos);
 }
 
 TEST_CASE("the summary says where the time went, step by step, adding up to the run's seconds", "[cli]") {

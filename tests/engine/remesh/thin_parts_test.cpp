@@ -98,6 +98,22 @@ TEST_CASE("thin_parts counts the edges outside where the reference is thinner th
   const ThinParts c = thin_parts(thick, ReferenceSurface(thick), 0.3, 1.5, 1);
   CHECK(c.outside == 0);
   CHECK(c.in_thin_parts == 0);
+  CHECK(c.at_irregular == 0);
+  // The tori's grids have valence 6 everywhere: no edge outside is at an irregular vertex.
+  CHECK(a.at_irregular == 0);
+  CHECK(b.at_irregular == 0);
+}
+
+TEST_CASE("thin_parts counts the edges outside at vertices of valence other than 6", "[thin]") {
+  // An icosphere keeps the icosahedron's 12 vertices of valence 5, none of them neighbours after
+  // subdivision: 60 edges touch one. With every edge outside all 60 count; with none, none.
+  const TriMesh sphere = test::make_icosphere(3, 4.0);
+  const ThinParts all = thin_parts(sphere, ReferenceSurface(sphere), 10.0, 20.0, 2);
+  CHECK(all.outside == sphere.n_edges());
+  CHECK(all.at_irregular == 60);
+  const ThinParts none = thin_parts(sphere, ReferenceSurface(sphere), 0.01, 20.0, 2);
+  CHECK(none.outside == 0);
+  CHECK(none.at_irregular == 0);
 }
 
 TEST_CASE("equalize reports the returned mesh's edges outside and those in thin parts", "[thin]") {

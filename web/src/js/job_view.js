@@ -196,7 +196,8 @@ export class JobView {
     if (job.outcome) text += ` · ${typeof job.outcome === 'string' ? job.outcome : JSON.stringify(job.outcome)}`;
     const thin = job.thin_parts;
     if (thin && thin.outside > 0)
-      text += ` · ${thin.outside} edges outside, ${thin.in_thin_parts} of them where the input is thinner than ${thin.limit.toPrecision(3)}`;
+      text += ` · ${thin.outside} edges outside, ${thin.in_thin_parts} of them where the input is thinner than ${thin.limit.toPrecision(3)}` +
+        (thin.at_irregular_vertices !== undefined ? `, ${thin.at_irregular_vertices} at vertices of valence other than 6` : '');
     const secs = this.rows.reduce((s, r) => s + (r.seconds || 0), 0);
     if (secs) text += ` · ${secs.toFixed(1)} s`;
     $('progress-text').textContent = text;
