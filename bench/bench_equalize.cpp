@@ -149,12 +149,14 @@ void print_row(const IterationStats& s) {
 void print_thin_parts(const TriMesh& input, const TriMesh& output, const Options& o) {
   std::vector<Vec3> mids[2], normals[2];  // [0] outside, [1] inside (a sample of at most 4000)
   const std::size_t stride = std::max<std::size_t>(1, output.n_edges() / 4000);
-  std::size_t k = 0;
+  std::size_t k = 0, irregular = 0;  // edges outside with an end of valence other than 6 (4 on the boundary)
+  auto regular = [&](OpenMesh::VertexHandle v) { return output.valence(v) == (output.is_boundary(v) ? 4u : 6u); };
   for (auto e : output.edges()) {
     const double l = output.calc_edge_length(e);
     const int in = l >= kEmin && l <= kEmax;
     if (in && k++ % stride != 0) continue;
     const auto h = output.halfedge_handle(e, 0);
+    if (!in && !(regular(output.from_vertex_handle(h)) && regular(output.to_vertex_handle(h)))) ++irregular;
     Vec3 n(0, 0, 0);
     for (auto g : {h, output.opposite_halfedge_handle(h)})
       if (!output.is_boundary(g)) n += geom::face_normal(output, output.face_handle(g)).normalized();
@@ -172,8 +174,8 @@ void print_thin_parts(const TriMesh& input, const TriMesh& output, const Options
   const auto thin = std::lower_bound(t[0].begin(), t[0].end(), tube) - t[0].begin();
   auto median = [](const std::vector<double>& v) { return v.empty() ? 0.0 : v[v.size() / 2]; };
   std::printf("ours : %zu edges outside; the input's thickness at them: median %.2f (at edges inside: %.2f); %zu of "
-              "them where it is below %.2f = 2 e_min / sqrt(3)\n",
-              t[0].size(), median(t[0]), median(t[1]), static_cast<std::size_t>(thin), tube);
+              "them where it is below %.2f = 2 e_min / sqrt(3); %zu with an end of valence other than 6\n",
+              t[0].size(), median(t[0]), median(t[1]), static_cast<std::size_t>(thin), tube, irregular);
 }
 
 /// The quality row printed for each remesher; returns the Hausdorff distance (% of the bbox diagonal).
