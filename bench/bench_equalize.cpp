@@ -150,7 +150,7 @@ void print_thin_parts(const TriMesh& input, const TriMesh& output, const Options
   std::vector<Vec3> mids[2], normals[2];  // [0] outside, [1] inside (a sample of at most 4000)
   const std::size_t stride = std::max<std::size_t>(1, output.n_edges() / 4000);
   std::size_t k = 0, irregular = 0;  // edges outside with an end of valence other than 6 (4 on the boundary)
-  auto regular = [&](OpenMesh::VertexHandle v) { return output.valence(v) == (output.is_boundary(v) ? 4u : 6u); };
+  auto regular = [&](OpenMesh::VertexHandle v) { return output.valence(v) == geom::target_valence(output, v); };
   for (auto e : output.edges()) {
     const double l = output.calc_edge_length(e);
     const int in = l >= kEmin && l <= kEmax;

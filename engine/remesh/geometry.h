@@ -34,6 +34,9 @@ struct Box {
 
 namespace remesh::geom {
 
+/// The valence Algorithm 4 aims at: 6 inside, 4 on the boundary.
+inline unsigned target_valence(const TriMesh& mesh, OpenMesh::VertexHandle v) { return mesh.is_boundary(v) ? 4u : 6u; }
+
 /// Smallest interior angle of triangle (a, b, c), in radians; 0 for a degenerate triangle.
 double min_angle(const Vec3& a, const Vec3& b, const Vec3& c);
 

@@ -258,30 +258,22 @@ class Cleanup {
   void spread_stamps() {
     const std::size_t n = mesh_.n_vertices();
     if (changed_near_.size() < n) changed_near_.resize(n, 0), changed_close_.resize(n, 0);
-    if (walk_mark_.size() < n) walk_mark_.resize(n, 0);
     // One walk per fix (the stamps of a fix share its tick, and ticks only grow).
     for (std::size_t begin = 0; begin < stamped_.size();) {
       const std::uint32_t tick = stamped_[begin].second;
       std::size_t end = begin;
       ring_walk_.clear();
-      ++walk_epoch_;
       for (; end < stamped_.size() && stamped_[end].second == tick; ++end) {
         // A vertex a later collapse removed lies in no ring now; the kept one was stamped then.
         const VertexHandle v = mesh_.vertex_handle(stamped_[end].first);
-        if (mesh_.status(v).deleted()) continue;
-        if (walk_mark_[v.idx()] != walk_epoch_) walk_mark_[v.idx()] = walk_epoch_, ring_walk_.push_back(v);
+        if (!mesh_.status(v).deleted()) ring_walk_.push_back(v);
       }
-      for (std::size_t from = 0, ring = 0; ring <= kFailureRings; ++ring) {
-        const std::size_t to = ring_walk_.size();
-        for (std::size_t i = from; i < to; ++i) {
-          const int v = ring_walk_[i].idx();
-          changed_near_[v] = tick;
-          if (ring <= kRelocateRings) changed_close_[v] = tick;
-          if (ring == kFailureRings) continue;
-          for (auto w : mesh_.vv_range(ring_walk_[i]))
-            if (walk_mark_[w.idx()] != walk_epoch_) walk_mark_[w.idx()] = walk_epoch_, ring_walk_.push_back(w);
-        }
-        from = to;
+      grow_rings(ring_walk_, kFailureRings, &ring_ends_);
+      for (std::size_t i = 0; i < ring_walk_.size(); ++i) {
+        const int v = ring_walk_[i].idx();
+        changed_near_[v] = tick;
+        if (i < ring_ends_[kRelocateRings]) changed_close_[v] = tick;
+        patch_mark_[v] = 0;
       }
       begin = end;
     }
@@ -527,25 +519,22 @@ class Cleanup {
   }
 
   /// Adds to `patch` every vertex within `rings` rings of it (kPatchRings for a patch), marking
-  /// all in patch_mark_ (the caller clears the marks). Stops early, returning false, at the first
-  /// vertex added for which `stop` is true.
-  template <class Stop = bool (*)(VertexHandle)>
-  bool grow_rings(std::vector<VertexHandle>& patch, std::size_t rings = kPatchRings,
-                  Stop stop = [](VertexHandle) { return false; }) {
+  /// all in patch_mark_ (the caller clears the marks). With `ring_ends`, (*ring_ends)[r] is the
+  /// size of `patch` once the vertices within r rings are in it ([0]: the seeds).
+  void grow_rings(std::vector<VertexHandle>& patch, std::size_t rings = kPatchRings,
+                  std::vector<std::size_t>* ring_ends = nullptr) {
     std::vector<char>& in = patch_mark_;
     if (in.size() < mesh_.n_vertices()) in.assign(mesh_.n_vertices(), 0);
     for (auto v : patch) in[v.idx()] = 1;
+    if (ring_ends) ring_ends->assign(1, patch.size());
     for (std::size_t begin = 0, r = 0; r < rings; ++r) {
       const std::size_t end = patch.size();
       for (std::size_t i = begin; i < end; ++i)
         for (auto w : mesh_.vv_range(patch[i]))
-          if (!in[w.idx()]) {
-            in[w.idx()] = 1, patch.push_back(w);
-            if (stop(w)) return false;
-          }
+          if (!in[w.idx()]) in[w.idx()] = 1, patch.push_back(w);
       begin = end;
+      if (ring_ends) ring_ends->push_back(patch.size());
     }
-    return true;
   }
 
   /// The faces a relaxation of the patch around v can move: those incident to its vertices.
@@ -688,9 +677,8 @@ class Cleanup {
   /// Per vertex: the tick of the last fix that changed a vertex within kFailureRings rings of it,
   /// and within kRelocateRings rings.
   std::vector<std::uint32_t> changed_near_, changed_close_;
-  std::vector<std::uint32_t> walk_mark_;  ///< spread_stamps' visited marks, by walk_epoch_
-  std::uint32_t walk_epoch_ = 0;
   std::vector<VertexHandle> ring_walk_;   ///< spread_stamps' walk (reused buffer)
+  std::vector<std::size_t> ring_ends_;    ///< and its rings' ends (grow_rings)
   std::vector<std::uint32_t> failed_at_;      ///< per edge: the tick at its last failure, 0 = none
   std::vector<std::uint32_t> relocate_failed_at_;  ///< per vertex: the tick its last relocation failed, 0 = none
   /// Patch relaxations left in this cleanup (interval_cleanup's `patch_budget`).

@@ -39,7 +39,7 @@ ThinParts thin_parts(const TriMesh& mesh, const ReferenceSurface& reference, dou
     if (l < e_min || l > e_max) outside.push_back(e);
   }
   out.outside = outside.size();
-  auto irregular = [&](OpenMesh::VertexHandle v) { return mesh.valence(v) != (mesh.is_boundary(v) ? 4u : 6u); };
+  auto irregular = [&](OpenMesh::VertexHandle v) { return mesh.valence(v) != geom::target_valence(mesh, v); };
   for (auto e : outside) {
     const auto h = mesh.halfedge_handle(e, 0);
     if (irregular(mesh.from_vertex_handle(h)) || irregular(mesh.to_vertex_handle(h))) ++out.at_irregular;
