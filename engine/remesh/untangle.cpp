@@ -1,6 +1,7 @@
 #include "remesh/untangle.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <numeric>
@@ -13,6 +14,7 @@
 #include "remesh/point_index.h"
 #include "remesh/projection.h"
 #include "remesh/self_intersections.h"
+#include "remesh/valence_flips.h"
 
 namespace remesh {
 
@@ -156,7 +158,70 @@ class Untangler {
     return moved;
   }
 
+  /// One round of flips over the edges of the crossing faces of `pairs` (try_flip); returns the
+  /// flips kept.
+  std::size_t flip_round(const Pairs& pairs) {
+    if (!face_index_) index_faces();
+    std::vector<OpenMesh::EdgeHandle> edges;
+    for (const auto& [f, g] : pairs)
+      for (unsigned face : {f, g})
+        for (auto e : mesh_.fe_range(mesh_.face_handle(face))) edges.push_back(e);
+    std::sort(edges.begin(), edges.end());
+    edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
+    std::size_t kept = 0;
+    for (auto e : edges)
+      if (try_flip(e)) ++kept;
+    if (kept > 0) failures_.clear();  // the flipped quads changed their vertices' stars
+    return kept;
+  }
+
  private:
+  // ---- flips ----
+
+  /// Crossing pairs between the triangles `tris` (adjacent: no pair between them) and the faces
+  /// `near` but `skip` (the faces the triangles are, or replace).
+  std::size_t crossings_of(const std::array<std::array<Vec3, 3>, 2>& tris, const FaceHandle (&skip)[2],
+                           const std::vector<std::uint32_t>& near) const {
+    std::size_t n = 0;
+    for (std::uint32_t j : near) {
+      const FaceHandle g = mesh_.face_handle(j);
+      if (g == skip[0] || g == skip[1]) continue;
+      VertexHandle c[3];
+      geom::face_vertices(mesh_, g, c);
+      const Vec3 &d = mesh_.point(c[0]), &e = mesh_.point(c[1]), &f = mesh_.point(c[2]);
+      for (const auto& t : tris) n += triangles_cross(t[0], t[1], t[2], d, e, f);
+    }
+    return n;
+  }
+
+  /// Flips e when the valence flips' rule allows it but for the agreement of old and new normals
+  /// (flip_is_safe with f = 0 and turned_ok: in a tangle the faces are turned every way already,
+  /// and that test refused most of the flips that take two faces out of each other), the flip
+  /// lowers the crossings of its two faces and takes no edge out of the interval. The quad's corners do not move, so its faces, before and after, lie
+  /// in the ball around the corners' centroid that reaches the farthest corner: the faces that can
+  /// cross them are those faces_near() finds there. A flip moves the two faces' centroids within
+  /// that ball, which the index does not see: drift_ grows by the ball's diameter.
+  bool try_flip(OpenMesh::EdgeHandle e) {
+    if (!flip_is_safe(mesh_, e, 0.0, nullptr, /*turned_ok=*/true)) return false;
+    const Quad q = quad_of(mesh_, e);
+    const Vec3 p[4] = {mesh_.point(q.v0), mesh_.point(q.v1), mesh_.point(q.v2), mesh_.point(q.v3)};
+    if (outside((p[3] - p[2]).norm()) && !outside((p[1] - p[0]).norm())) return false;
+    const Vec3 centre = 0.25 * (p[0] + p[1] + p[2] + p[3]);
+    double radius = 0;
+    for (const Vec3& x : p) radius = std::max(radius, (x - centre).norm());
+    std::vector<std::uint32_t>& near = near_;
+    faces_near(centre, radius, near);
+    const HalfedgeHandle h = mesh_.halfedge_handle(e, 0);
+    const FaceHandle faces[2] = {mesh_.face_handle(h), mesh_.opposite_face_handle(h)};
+    // Old faces (v0, v1, v2), (v1, v0, v3); new faces (v3, v1, v2), (v2, v0, v3) (quad_of).
+    const std::size_t before = crossings_of({{{p[0], p[1], p[2]}, {p[1], p[0], p[3]}}}, faces, near);
+    if (before == 0 || crossings_of({{{p[3], p[1], p[2]}, {p[2], p[0], p[3]}}}, faces, near) >= before) return false;
+    mesh_.flip(e);
+    for (const Vec3& x : p) note_move(x, x);
+    drift_ = std::max(drift_, 2 * radius);
+    return true;
+  }
+
   // ---- vertex moves ----
 
   /// Crossing pairs between v's faces and the faces `near` (or other faces of the star).
@@ -492,6 +557,15 @@ UntangleCounts untangle(TriMesh& mesh, const ReferenceSurface& reference, double
     }
   };
   move_rounds();
+  if (!pairs.empty()) {
+    const std::size_t flipped = untangler.flip_round(pairs);
+    counts.moved += flipped;
+    counts.flipped += flipped;
+    if (flipped > 0) {
+      pairs = untangler.refresh(pairs, threads);
+      move_rounds();
+    }
+  }
   if (!pairs.empty()) {
     const std::size_t flattened = untangler.flatten(pairs);
     counts.moved += flattened;

@@ -29,7 +29,7 @@ VertexInfo::VertexInfo(const TriMesh& mesh, unsigned threads)
   });
 }
 
-bool flip_is_safe(const TriMesh& mesh, EdgeHandle e, double f, const VertexInfo* info) {
+bool flip_is_safe(const TriMesh& mesh, EdgeHandle e, double f, const VertexInfo* info, bool turned_ok) {
   if (mesh.status(e).deleted() || mesh.is_boundary(e) || !mesh.is_flip_ok(e)) return false;
   const Quad q = quad_of(mesh, e);
   // The ends lose an edge: keep interior valence >= 3 and boundary valence >= 2.
@@ -42,8 +42,9 @@ bool flip_is_safe(const TriMesh& mesh, EdgeHandle e, double f, const VertexInfo*
   // Old faces (v0, v1, v2), (v1, v0, v3); new faces (v3, v1, v2), (v2, v0, v3).
   const Vec3 old_a = geom::cross_normal(p0, p1, p2), old_b = geom::cross_normal(p1, p0, p3);
   const Vec3 new_a = geom::cross_normal(p3, p1, p2), new_b = geom::cross_normal(p2, p0, p3);
-  for (const Vec3& n : {new_a, new_b})
-    if (!geom::normals_agree(old_a, n) || !geom::normals_agree(old_b, n)) return false;
+  if (!turned_ok)
+    for (const Vec3& n : {new_a, new_b})
+      if (!geom::normals_agree(old_a, n) || !geom::normals_agree(old_b, n)) return false;
   if (!geom::adjacent_ok(old_a, old_b, new_a, new_b)) return false;
   // The four outer neighbours against the new face that takes over their shared edge.
   const HalfedgeHandle h0 = mesh.halfedge_handle(e, 0), h1 = mesh.halfedge_handle(e, 1);

@@ -120,7 +120,10 @@ std::size_t valence_flips(TriMesh& mesh, double f, int max_sweeps = 3, unsigned 
 
 /// Safety part of a flip alone (legal, no fold, no degenerate triangle, minimum angle no lower than
 /// f * before). Used by the interval cleanup too. With `info` (current for `mesh`), the ends'
-/// valences come from it instead of circulating them: the same answer.
-bool flip_is_safe(const TriMesh& mesh, OpenMesh::EdgeHandle e, double f, const VertexInfo* info = nullptr);
+/// valences come from it instead of circulating them: the same answer. With `turned_ok`, the new
+/// faces need not agree with the old ones (untangle.h: a tangle's faces are turned already); the
+/// tests of adjacent faces still refuse a face turned over against its neighbours.
+bool flip_is_safe(const TriMesh& mesh, OpenMesh::EdgeHandle e, double f, const VertexInfo* info = nullptr,
+                  bool turned_ok = false);
 
 }  // namespace remesh
