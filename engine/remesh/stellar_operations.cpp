@@ -66,7 +66,7 @@ VertexHandle split_edge(TriMesh& mesh, EdgeHandle e, double target) {
   return mesh.split(e, p);
 }
 
-bool collapse_geometry_ok(const TriMesh& mesh, HalfedgeHandle h, const Vec3& p, double max_length) {
+bool collapse_geometry_ok(const TriMesh& mesh, HalfedgeHandle h, const Vec3& p, double max_length, bool turned_ok) {
   const VertexHandle v0 = mesh.from_vertex_handle(h), v1 = mesh.to_vertex_handle(h);
   const FaceHandle gone0 = mesh.face_handle(h), gone1 = mesh.face_handle(mesh.opposite_halfedge_handle(h));
   geom::AngleFloor floor([&] { return std::min(geom::star_min_angle(mesh, v0), geom::star_min_angle(mesh, v1)); });
@@ -78,7 +78,7 @@ bool collapse_geometry_ok(const TriMesh& mesh, HalfedgeHandle h, const Vec3& p, 
       Vec3 q[3];
       for (int k = 0; k < 3; ++k) q[k] = (c[k] == v0 || c[k] == v1) ? p : mesh.point(c[k]);
       const Vec3 n_after = geom::cross_normal(q[0], q[1], q[2]);
-      if (!geom::normals_agree(geom::face_normal(mesh, f), n_after)) return false;
+      if (!turned_ok && !geom::normals_agree(geom::face_normal(mesh, f), n_after)) return false;
       if (floor.breaks(q[0], q[1], q[2])) return false;
       // No fold against a neighbour (those across the removed faces are not checked).
       for (auto g : mesh.ff_range(f)) {

@@ -73,8 +73,11 @@ bool plan_collapse(const TriMesh& mesh, OpenMesh::EdgeHandle e, double target, d
 /// Would collapsing `h` with the kept vertex at `p` fold or degenerate a triangle, sharpen a pair of
 /// adjacent faces past geom::kMinAdjacentCos (those around its ends, and the two that become
 /// neighbours where each removed face was), or create an edge longer than max_length? (Geometric
-/// part of plan_collapse; topology is checked there.)
-bool collapse_geometry_ok(const TriMesh& mesh, OpenMesh::HalfedgeHandle h, const Vec3& p, double max_length);
+/// part of plan_collapse; topology is checked there.) With `turned_ok`, the faces need not keep their
+/// normals' directions (untangle.h: a tangle's faces are turned already); the tests of adjacent
+/// faces still refuse a face turned over against its neighbours.
+bool collapse_geometry_ok(const TriMesh& mesh, OpenMesh::HalfedgeHandle h, const Vec3& p, double max_length,
+                          bool turned_ok = false);
 
 /// Carries out a plan; returns the kept vertex.
 OpenMesh::VertexHandle apply_collapse(TriMesh& mesh, const CollapsePlan& plan);

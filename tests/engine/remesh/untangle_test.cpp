@@ -4,6 +4,7 @@
 #include <catch2/catch.hpp>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <random>
 #include <utility>
@@ -276,7 +277,7 @@ TEST_CASE("untangle never cuts a thin protrusion off: the finger's tip stays nea
   const ReferenceSurface surface(reference);
   REQUIRE(test::check_mesh_valid(reference) == "");
   const Vec3 apex(0, 0, 9.0);
-  int tangled = 0, flattened = 0;
+  int tangled = 0, flattened = 0, collapsed = 0;
   for (unsigned seed = 1; seed <= 30; ++seed) {
     INFO("seed " << seed);
     std::mt19937 rng(seed);
@@ -290,21 +291,31 @@ TEST_CASE("untangle never cuts a thin protrusion off: the finger's tip stays nea
     const UntangleCounts counts = untangle(mesh, surface, 1.2, 1.8, 1);
     CHECK(counts.left == find_self_intersections(mesh, 1));
     flattened += counts.flattened > 0;
+    collapsed += counts.collapsed > 0;
+    // A collapse removes a vertex and keeps the topology (a closed sphere: V - E + F = 2).
+    CHECK(mesh.n_vertices() + counts.collapsed == before.n_vertices());
+    CHECK(static_cast<long>(mesh.n_vertices()) - static_cast<long>(mesh.n_edges()) + static_cast<long>(mesh.n_faces()) == 2);
+    // Every face a triangle, none degenerate, no element deleted, every vertex manifold (the
+    // crumpled faces may fold: no fold test).
+    CHECK(test::check_mesh_valid(mesh, 1e-12, 1.0) == "");
     for (auto v : before.vertices()) CHECK(test::brute_distance(mesh, before.point(v)) <= 1.2 + 1e-9);
     CHECK(test::brute_distance(mesh, apex) <= 1.2);
   }
   CHECK(tangled >= 10);
+  // Collapses mend some of these tangles (measured: in 17 of the 24 draws that tangled), and keep
+  // the tip: the distances above.
+  CHECK(collapsed >= 5);
   // A disk that keeps the finger is still flattened (measured: 1 of 27 draws; without the rule, 16
   // were, their tips cut off by 1.6 to 3.8).
   CHECK(flattened > 0);
 }
 
-TEST_CASE("untangle's flips keep the vertices and the topology and take no edge out of the interval",
-          "[untangle]") {
+TEST_CASE("untangle's flips and collapses keep the topology and the boundary", "[untangle]") {
   // The rippled reference of the test above, crumpled at random. Flips change which vertices a
-  // face joins, never the vertices themselves nor the counts of the mesh; like the vertex moves
-  // they take no edge out of [e_min, e_max] (only a flattened disk may), and each kept flip lowers
-  // the crossings, so the pairs left are never more than before.
+  // face joins; collapses remove a vertex onto a neighbour that stays where it is. Neither changes
+  // the Euler characteristic or the boundary; flips and vertex moves take no edge out of
+  // [e_min, e_max] (a collapse may leave a short one, a flattened disk any), and each kept edit
+  // lowers the crossings, so the pairs left are never more.
   auto outside = [](const TriMesh& m) {
     std::size_t n = 0;
     for (auto e : m.edges()) {
@@ -312,6 +323,16 @@ TEST_CASE("untangle's flips keep the vertices and the topology and take no edge 
       n += l < 1.2 || l > 1.8;
     }
     return n;
+  };
+  auto euler = [](const TriMesh& m) {
+    return static_cast<long>(m.n_vertices()) - static_cast<long>(m.n_edges()) + static_cast<long>(m.n_faces());
+  };
+  auto boundary = [](const TriMesh& m) {
+    std::vector<std::array<double, 3>> points;
+    for (auto v : m.vertices())
+      if (m.is_boundary(v)) points.push_back({m.point(v)[0], m.point(v)[1], m.point(v)[2]});
+    std::sort(points.begin(), points.end());
+    return points;
   };
   const Vec3 centre(15, 13, 0);
   TriMesh reference = test::make_hex_lattice_patch(20, 20, 1.5);
@@ -329,22 +350,23 @@ TEST_CASE("untangle's flips keep the vertices and the topology and take no edge 
     for (auto v : mesh.vertices())
       if ((reference.point(v) - centre).norm() < 3.5) mesh.point(v) += Vec3(across(rng), across(rng), up(rng));
     const std::size_t pairs = find_self_intersections(mesh, 1).size(), out = outside(mesh);
-    const std::size_t vertices = mesh.n_vertices(), edges = mesh.n_edges(), faces = mesh.n_faces();
+    const TriMesh before = mesh;
     const UntangleCounts counts = untangle(mesh, surface, 1.2, 1.8, 1);
-    CHECK(mesh.n_vertices() == vertices);
-    CHECK(mesh.n_edges() == edges);
-    CHECK(mesh.n_faces() == faces);
+    CHECK(euler(mesh) == euler(before));
+    CHECK(boundary(mesh) == boundary(before));
+    CHECK(mesh.n_vertices() + counts.collapsed == before.n_vertices());
     CHECK(counts.left.size() <= pairs);
     CHECK(counts.left == find_self_intersections(mesh, 1));
-    if (counts.flattened == 0) CHECK(outside(mesh) <= out);
-    if (counts.flipped == 0) continue;
-    ++flipped;
-    CHECK(counts.flipped <= counts.moved);
-    // The flips changed the connectivity: some vertex has another valence than in the lattice.
-    bool changed = false;
-    for (auto v : mesh.vertices()) changed = changed || mesh.valence(v) != reference.valence(v);
-    CHECK(changed);
+    if (counts.flattened == 0 && counts.collapsed == 0) CHECK(outside(mesh) <= out);
+    flipped += counts.flipped > 0;
+    if (counts.flipped == 0 && counts.collapsed == 0) continue;
+    // The edits changed the connectivity: some vertex has another valence than in the lattice.
+    std::vector<std::size_t> valences_before, valences_after;
+    for (auto v : before.vertices()) valences_before.push_back(before.valence(v));
+    for (auto v : mesh.vertices()) valences_after.push_back(mesh.valence(v));
+    CHECK(valences_after != valences_before);
   }
-  // Measured: flips were kept in 28 of the 40 draws.
+  // Measured: flips were kept in 28 of the 40 draws (collapses in none: on this lattice the vertex
+  // moves and flips mend what a collapse could; the finger test below has them).
   CHECK(flipped >= 10);
 }
