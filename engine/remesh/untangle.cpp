@@ -30,6 +30,9 @@ using Pairs = std::vector<std::pair<unsigned, unsigned>>;
 constexpr int kMoveRounds = 8;
 /// The fractions of the way to the ring's centroid a vertex move tries in turn.
 constexpr double kSteps[] = {1.0, 0.5, 0.25};
+/// Rounds of flips and collapses at most (each round runs while the last lowered the crossings).
+/// Measured (crossing face pairs, armadillo coarsened): 6 after one round, 0 after two.
+constexpr int kEditRounds = 4;
 /// The largest disk a tangle is flattened in: its vertices within this many rings of the tangle's.
 constexpr std::size_t kMaxPatchRings = 4;
 /// Gauss-Seidel sweeps of the membrane at most, and the move (relative to the mean edge of the
@@ -673,7 +676,10 @@ UntangleCounts untangle(TriMesh& mesh, const ReferenceSurface& reference, double
     }
   };
   move_rounds();
-  if (!pairs.empty()) {
+  // Flips, then collapses, each followed by vertex moves, again while they lower the crossings
+  // (kEditRounds at most): one edit can free the next.
+  for (int round = 0; round < kEditRounds && !pairs.empty(); ++round) {
+    const std::size_t at_start = pairs.size();
     const std::size_t flipped = untangler->flip_round(pairs);
     counts.moved += flipped;
     counts.flipped += flipped;
@@ -681,8 +687,7 @@ UntangleCounts untangle(TriMesh& mesh, const ReferenceSurface& reference, double
       pairs = untangler->refresh(pairs, threads);
       move_rounds();
     }
-  }
-  if (!pairs.empty()) {
+    if (pairs.empty()) break;
     const std::size_t collapsed = collapse_round(mesh, e_max, pairs);
     if (collapsed > 0) {
       counts.moved += collapsed;
@@ -692,6 +697,7 @@ UntangleCounts untangle(TriMesh& mesh, const ReferenceSurface& reference, double
       untangler.emplace(mesh, reference, e_min, e_max);
       move_rounds();
     }
+    if (pairs.size() >= at_start) break;
   }
   if (!pairs.empty()) {
     const std::size_t flattened = untangler->flatten(pairs);
