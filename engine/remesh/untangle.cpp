@@ -206,10 +206,11 @@ class Untangler {
   /// Flips e when the valence flips' rule allows it but for the agreement of old and new normals
   /// (flip_is_safe with f = 0 and turned_ok: in a tangle the faces are turned every way already,
   /// and that test refused most of the flips that take two faces out of each other), the flip
-  /// lowers the crossings of its two faces and takes no edge out of the interval. The quad's corners do not move, so its faces, before and after, lie
-  /// in the ball around the corners' centroid that reaches the farthest corner: the faces that can
-  /// cross them are those faces_near() finds there. A flip moves the two faces' centroids within
-  /// that ball, which the index does not see: drift_ grows by the ball's diameter.
+  /// lowers the crossings of its two faces and takes no edge out of the interval. The quad's
+  /// corners do not move, so its faces, before and after, lie in the ball around the corners'
+  /// centroid that reaches the farthest corner: the faces that can cross them are those
+  /// faces_near() finds there. A flip moves the two faces' centroids within that ball, which the
+  /// index does not see: drift_ grows by the ball's diameter.
   bool try_flip(OpenMesh::EdgeHandle e) {
     if (!flip_is_safe(mesh_, e, 0.0, nullptr, /*turned_ok=*/true)) return false;
     const Quad q = quad_of(mesh_, e);
@@ -589,7 +590,8 @@ class CollapseJudge {
 
   /// Records a collapse of h, before it is carried out.
   void collapsing(HalfedgeHandle h) {
-    drift_ = std::max(drift_, (mesh_.point(mesh_.from_vertex_handle(h)) - mesh_.point(mesh_.to_vertex_handle(h))).norm());
+    const Vec3 gone = mesh_.point(mesh_.from_vertex_handle(h)), stays = mesh_.point(mesh_.to_vertex_handle(h));
+    drift_ = std::max(drift_, (gone - stays).norm());
   }
 
  private:
@@ -639,8 +641,10 @@ std::size_t collapse_round(TriMesh& mesh, double e_max, const Pairs& pairs) {
   for (auto e : edges_of(mesh, pairs)) {
     if (mesh.status(e).deleted()) continue;
     const HalfedgeHandle h0 = mesh.halfedge_handle(e, 0);
-    const bool boundary_ends = mesh.is_boundary(mesh.from_vertex_handle(h0)) && mesh.is_boundary(mesh.to_vertex_handle(h0));
-    if ((boundary_ends && !mesh.is_boundary(e)) || !component_larger_than(mesh, mesh.from_vertex_handle(h0), 4)) continue;
+    const VertexHandle a = mesh.from_vertex_handle(h0), b = mesh.to_vertex_handle(h0);
+    // No interior edge between two boundary vertices (it would pinch), no component below 4.
+    if ((mesh.is_boundary(a) && mesh.is_boundary(b) && !mesh.is_boundary(e)) || !component_larger_than(mesh, a, 4))
+      continue;
     for (const HalfedgeHandle h : {h0, mesh.opposite_halfedge_handle(h0)}) {
       const VertexHandle gone = mesh.from_vertex_handle(h), stays = mesh.to_vertex_handle(h);
       if (mesh.is_boundary(gone) || !mesh.is_collapse_ok(h)) continue;
