@@ -3,7 +3,6 @@
 /// no projection is needed).
 
 #include <iostream>
-#include <map>
 
 #include "args.h"
 #include "commands.h"
@@ -16,20 +15,6 @@ const std::vector<OptionSpec> kSpec = {
     {"weld", "", "weld duplicate vertices at the same position while reading"},
     {"quiet", "", "do not report counts"},
 };
-
-/// "1200 faces: 12 pentagons, 1188 hexagons" style histogram of face sizes.
-void print_dual_counts(std::ostream& out, const std::string& path, const PolyMesh& dual) {
-  std::map<std::size_t, std::size_t> sizes;
-  for (auto f : dual.faces()) ++sizes[dual.valence(f)];
-  out << "wrote " << path << ": " << dual.n_vertices() << " vertices, " << dual.n_edges() << " edges, "
-      << dual.n_faces() << " faces (";
-  bool first = true;
-  for (auto [size, count] : sizes) {
-    out << (first ? "" : ", ") << count << " with " << size << " sides";
-    first = false;
-  }
-  out << ")\n";
-}
 
 }  // namespace
 
@@ -50,7 +35,8 @@ int run_dual(const std::vector<std::string>& args) {
   write_mesh_file(to_soup(dual), out);
   if (!a.has("quiet")) {
     print_repairs(std::cerr, loaded.repairs);
-    print_dual_counts(std::cerr, out, dual);
+    std::cerr << "wrote " << out << ":\n";
+    print_dual_stats(std::cerr, dual_stats(dual));
   }
   return 0;
 }

@@ -104,7 +104,7 @@ void write_text_file(const std::string& path, const std::string& text) {
   if (!f.flush()) throw std::runtime_error("write failed: " + path);
 }
 
-void print_final(const TriMesh& mesh, const Job& job, const Result& result) {
+void print_final(const TriMesh& mesh, const Job& job, const Result& result, const std::optional<DualStats>& dual) {
   const IterationStats q = measure(mesh, job.params.e_min, job.params.e_max, job.params.threads);
   const MeshSummary s = summarize(mesh);
   std::printf("result: %zu vertices, %zu edges, %zu faces\n", s.vertices, s.edges, s.faces);
@@ -121,6 +121,11 @@ void print_final(const TriMesh& mesh, const Job& job, const Result& result) {
   std::printf("  regular vertices:     %.2f %%\n", q.regular_percent);
   std::printf("  edge length:          mean %.6g, deviation %.4g, min %.6g, max %.6g\n", q.mean, q.deviation,
               s.min_edge, s.max_edge);
+  if (dual) {
+    std::fflush(stdout);
+    print_dual_stats(std::cout, *dual);
+    std::cout.flush();
+  }
   std::printf("  outcome:              %s after %d iteration%s, %.2f s\n", outcome_name(result.outcome),
               result.iterations_done, result.iterations_done == 1 ? "" : "s", result.seconds);
   // Where the time went (Result::phases); "other" is the rest: statistics rows, snapshots.
@@ -164,12 +169,17 @@ int run_remesh(const std::vector<std::string>& args) {
   progress.finish();
 
   write_mesh_file(to_soup(mesh), job.out);
-  if (job.dual_out) write_mesh_file(to_soup(trivalent_dual(mesh, &*reference)), *job.dual_out);
+  std::optional<DualStats> dual_summary;
+  if (job.dual_out) {
+    const PolyMesh dual = trivalent_dual(mesh, &*reference);
+    write_mesh_file(to_soup(dual), *job.dual_out);
+    dual_summary = dual_stats(dual, job.params.e_min, job.params.e_max);
+  }
   if (job.stats_out) {
     const bool json = job.stats_out->size() > 5 && job.stats_out->ends_with(".json");
     write_text_file(*job.stats_out, json ? nlohmann::json(rows).dump(2) + "\n" : stats_to_csv(rows));
   }
-  if (!job.quiet) print_final(mesh, job, result);
+  if (!job.quiet) print_final(mesh, job, result, dual_summary);
   if (result.outcome == Outcome::Cancelled) {
     std::cerr << "remesh: cancelled after " << result.iterations_done << " iterations; wrote the partial mesh to "
               << job.out << "\n";

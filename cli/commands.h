@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "dual/dual_stats.h"
 #include "io/mesh_io.h"
 
 namespace remesh::cli {
@@ -28,5 +29,8 @@ Format require_output_format(const std::string& path);
 LoadedMesh read_input_for(const std::string& in, const std::string& out, bool weld);
 /// One line per repair ("  kind (count): detail"); nothing when there were none.
 void print_repairs(std::ostream& out, const std::vector<Repair>& repairs);
+/// The dual's summary lines: atoms, bonds and rings by size; bond lengths; with an interval
+/// (DualStats::bond_max > 0), the bonds inside it.
+void print_dual_stats(std::ostream& out, const DualStats& s);
 
 }  // namespace remesh::cli

@@ -1,6 +1,7 @@
 /// \file common.cpp
 /// Helpers shared by the commands.
 
+#include <cstdio>
 #include <filesystem>
 #include <ostream>
 
@@ -34,6 +35,27 @@ Format require_output_format(const std::string& path) {
 
 void print_repairs(std::ostream& out, const std::vector<Repair>& repairs) {
   for (const auto& r : repairs) out << "  " << r.kind << " (" << r.count << "): " << r.detail << "\n";
+}
+
+void print_dual_stats(std::ostream& out, const DualStats& s) {
+  out << "  dual:                 " << s.atoms << " atoms, " << s.bonds << " bonds; rings:";
+  bool first = true;
+  for (const auto& [sides, count] : s.rings) {
+    out << (first ? " " : ", ") << count << " of " << sides << (first ? " sides" : "");
+    first = false;
+  }
+  if (first) out << " none";
+  out << "\n";
+  char line[256];
+  std::snprintf(line, sizeof line, "  bond length:          mean %.6g, deviation %.4g, min %.6g, max %.6g\n", s.mean,
+                s.deviation, s.min, s.max);
+  out << line;
+  if (s.bond_max > 0) {
+    std::snprintf(line, sizeof line,
+                  "  bonds inside [%.6g, %.6g] = [e_min, e_max] / sqrt(3): %.3f %% (%zu short, %zu long)\n",
+                  s.bond_min, s.bond_max, 100.0 * s.inside_fraction(), s.short_bonds, s.long_bonds);
+    out << line;
+  }
 }
 
 LoadedMesh read_input_for(const std::string& in, const std::string& out, bool weld) {

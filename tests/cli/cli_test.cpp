@@ -241,6 +241,12 @@ TEST_CASE("dual writes one polygon per interior vertex", "[cli]") {
   CHECK(c.faces == interior);
   CHECK(c.vertices == grid.n_faces());
   for (auto n : c.face_sizes) CHECK(n == 6);
+  // The summary: one atom per triangle, every ring a hexagon, bonds of 1 / sqrt(3) (equilateral
+  // triangles of side 1).
+  CHECK(r.err.find(std::to_string(grid.n_faces()) + " atoms, ") != std::string::npos);
+  CHECK(r.err.find("rings: " + std::to_string(interior) + " of 6 sides\n") != std::string::npos);
+  CHECK(r.err.find("bond length:          mean 0.57735, deviation ") != std::string::npos);
+  CHECK(r.err.find(", min 0.57735, max 0.57735\n") != std::string::npos);
 
   REQUIRE(remesh_cli({"dual", dir.file("lattice.obj"), dir.file("dual.xyz")}).exit_code == 0);
   CHECK(lines(read_text(dir.file("dual.xyz"))) >= grid.n_faces());
@@ -279,6 +285,10 @@ TEST_CASE("a short remesh run writes the mesh, the dual and one stats row per it
   const ObjCounts d = count_obj(dual);
   CHECK(d.vertices == j.at("faces").get<std::size_t>());
   CHECK(d.faces == j.at("vertices").get<std::size_t>());
+  // The summary describes that dual: its atoms and bonds, and the bonds against [0.1, 0.15] / sqrt(3).
+  CHECK(r.out.find("dual:                 " + std::to_string(d.vertices) + " atoms, " +
+                   std::to_string(j.at("edges").get<std::size_t>()) + " bonds; rings: ") != std::string::npos);
+  CHECK(r.out.find("bonds inside [0.057735, 0.0866025] = [e_min, e_max] / sqrt(3): ") != std::string::npos);
 
   const ProcessResult quiet = remesh_cli({dir.file("sphere.obj"), out, "--emin", "0.1", "--emax", "0.15",
                                           "--iterations", "2", "--quiet", "--stats", dir.file("stats.json")});
