@@ -1,6 +1,7 @@
 #include "job.h"
 
 #include <algorithm>
+#include <charconv>
 #include <chrono>
 #include <cmath>
 #include <ctime>
@@ -59,6 +60,44 @@ JobRecord::StepSeconds step_seconds_from_json(const json& j) {
   for (const PhaseField& f : kPhaseFields) s.steps.*f.seconds = j.at(f.name).get<double>();
   s.total = j.at("total").get<double>();
   return s;
+}
+
+/// {atoms, bonds, rings: {"5": n, "6": n, ...}, bond_length: {mean, deviation, min, max},
+/// bond_interval: [min, max], short_bonds, long_bonds, bonds_inside_fraction}.
+json dual_to_json(const DualStats& d) {
+  json rings = json::object();
+  for (const auto& [sides, count] : d.rings) rings[std::to_string(sides)] = count;
+  return json{{"atoms", d.atoms},
+              {"bonds", d.bonds},
+              {"rings", rings},
+              {"bond_length", {{"mean", d.mean}, {"deviation", d.deviation}, {"min", d.min}, {"max", d.max}}},
+              {"bond_interval", json::array({d.bond_min, d.bond_max})},
+              {"short_bonds", d.short_bonds},
+              {"long_bonds", d.long_bonds},
+              {"bonds_inside_fraction", d.inside_fraction()}};
+}
+
+DualStats dual_from_json(const json& j) {
+  DualStats d;
+  d.atoms = j.at("atoms").get<std::size_t>();
+  d.bonds = j.at("bonds").get<std::size_t>();
+  for (const auto& [sides, count] : j.at("rings").items()) {
+    std::size_t n = 0;
+    const auto [end, ec] = std::from_chars(sides.data(), sides.data() + sides.size(), n);
+    if (ec != std::errc() || end != sides.data() + sides.size()) throw std::runtime_error("bad dual.rings key");
+    d.rings[n] = count.get<std::size_t>();
+  }
+  const json& length = j.at("bond_length");
+  d.mean = length.at("mean").get<double>();
+  d.deviation = length.at("deviation").get<double>();
+  d.min = length.at("min").get<double>();
+  d.max = length.at("max").get<double>();
+  const json& interval = j.at("bond_interval");
+  d.bond_min = interval.at(0).get<double>();
+  d.bond_max = interval.at(1).get<double>();
+  d.short_bonds = j.at("short_bonds").get<std::size_t>();
+  d.long_bonds = j.at("long_bonds").get<std::size_t>();
+  return d;
 }
 
 }  // namespace
@@ -143,6 +182,7 @@ json job_to_json(const JobRecord& job, std::string_view prefix, double now) {
                                            {"at_irregular_vertices", job.thin_parts->at_irregular}}
                                      : json(nullptr)},
       {"seconds_by_step", job.seconds_by_step ? step_seconds_to_json(*job.seconds_by_step) : json(nullptr)},
+      {"dual", job.dual ? dual_to_json(*job.dual) : json(nullptr)},
       {"error", job.error ? json(*job.error) : json(nullptr)},
       {"timings",
        {{"queued_seconds", std::max(0.0, queued_end - job.created_at)},
@@ -184,6 +224,8 @@ JobRecord job_from_json(const json& j) {
     }
     if (const auto t = j.find("seconds_by_step"); t != j.end() && !t->is_null())
       job.seconds_by_step = step_seconds_from_json(*t);
+    // Absent in documents written before the field existed.
+    if (const auto d = j.find("dual"); d != j.end() && !d->is_null()) job.dual = dual_from_json(*d);
     if (!j.at("error").is_null()) job.error = j.at("error").get<std::string>();
     return job;
   } catch (const json::exception& e) {

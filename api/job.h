@@ -10,6 +10,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "dual/dual_stats.h"
 #include "remesh/equalize.h"
 #include "remesh/params.h"
 
@@ -56,6 +57,9 @@ struct JobRecord {
     double total = 0;
   };
   std::optional<StepSeconds> seconds_by_step;
+  /// Of the result's trivalent dual as an atom lattice (dual/dual_stats.h), its bonds judged
+  /// against [e_min, e_max] / sqrt(3); nullopt until the job succeeded.
+  std::optional<DualStats> dual;
   std::optional<std::string> error;
 };
 

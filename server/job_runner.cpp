@@ -56,6 +56,7 @@ RunOutput run_job(const remesh::api::JobRecord& job, std::string upload, unsigne
     return remesh::ReferenceSurface(input_mesh);
   }();
   remesh::PolyMesh dual = remesh::trivalent_dual(mesh, &reference);
+  out.dual = remesh::dual_stats(dual, params.e_min, params.e_max);
   for (const std::string& f : remesh::api::dual_formats())
     write("dual." + f, remesh::write_mesh(dual, format_of(f)));
   return out;

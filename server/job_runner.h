@@ -9,6 +9,7 @@
 #include <string_view>
 
 #include "api/job.h"
+#include "dual/dual_stats.h"
 #include "remesh/equalize.h"
 
 namespace remeshd {
@@ -19,6 +20,7 @@ struct RunOutput {
   remesh::ThinParts thin;  ///< Result::thin
   remesh::PhaseSeconds phases;  ///< Result::phases
   double seconds = 0;           ///< Result::seconds
+  remesh::DualStats dual;       ///< the dual's, against [e_min, e_max] / sqrt(3) (not when cancelled)
 };
 
 /// Receives each result file as soon as it is serialised: its name ("remeshed.obj", "dual.glb",

@@ -54,6 +54,7 @@ TEST_CASE("job document: fields, links only when succeeded, round trip", "[api][
   CHECK(doc["outcome"].is_null());
   CHECK(doc["thin_parts"].is_null());
   CHECK(doc["seconds_by_step"].is_null());
+  CHECK(doc["dual"].is_null());
   CHECK(doc["error"].is_null());
   CHECK(doc["params"]["emin"] == 0.5);
   CHECK(doc["params"]["weld"] == false);
@@ -77,7 +78,21 @@ TEST_CASE("job document: fields, links only when succeeded, round trip", "[api][
   PhaseSeconds phases;
   phases.stellar = 0.5, phases.projection = 0.25, phases.untangle = 0.125;
   r.seconds_by_step = JobRecord::StepSeconds{phases, 1.0};
+  DualStats dual;
+  dual.atoms = 1200, dual.bonds = 1800;
+  dual.rings = {{5, 12}, {6, 590}};
+  dual.mean = 0.875, dual.deviation = 0.0625, dual.min = 0.5, dual.max = 1.25;
+  dual.bond_min = 0.6875, dual.bond_max = 1.0625, dual.short_bonds = 36, dual.long_bonds = 108;
+  r.dual = dual;
   doc = job_to_json(r, "/api/v1", r.created_at + 100);
+  CHECK(doc["dual"]["atoms"] == 1200);
+  CHECK(doc["dual"]["bonds"] == 1800);
+  CHECK(doc["dual"]["rings"] == json{{"5", 12}, {"6", 590}});
+  CHECK(doc["dual"]["bond_length"] == json{{"mean", 0.875}, {"deviation", 0.0625}, {"min", 0.5}, {"max", 1.25}});
+  CHECK(doc["dual"]["bond_interval"] == json::array({0.6875, 1.0625}));
+  CHECK(doc["dual"]["short_bonds"] == 36);
+  CHECK(doc["dual"]["long_bonds"] == 108);
+  CHECK(doc["dual"]["bonds_inside_fraction"] == Approx(1.0 - 144.0 / 1800.0));
   CHECK(doc["seconds_by_step"]["stellar"] == 0.5);
   CHECK(doc["seconds_by_step"]["projection"] == 0.25);
   CHECK(doc["seconds_by_step"]["untangle"] == 0.125);
@@ -116,6 +131,24 @@ TEST_CASE("job document: fields, links only when succeeded, round trip", "[api][
     CHECK(before.thin_parts->in_thin_parts == 7);
     CHECK(before.thin_parts->at_irregular == 0);
   }
+  REQUIRE(back.dual);
+  CHECK(back.dual->atoms == 1200);
+  CHECK(back.dual->bonds == 1800);
+  CHECK(back.dual->rings == dual.rings);
+  CHECK(back.dual->mean == 0.875);
+  CHECK(back.dual->deviation == 0.0625);
+  CHECK(back.dual->min == 0.5);
+  CHECK(back.dual->max == 1.25);
+  CHECK(back.dual->bond_min == 0.6875);
+  CHECK(back.dual->bond_max == 1.0625);
+  CHECK(back.dual->short_bonds == 36);
+  CHECK(back.dual->long_bonds == 108);
+  {
+    // A ring size that is no number names the field.
+    json bad = doc;
+    bad["dual"]["rings"]["six"] = 3;
+    CHECK_THROWS_WITH(job_from_json(bad), Catch::Contains("dual.rings"));
+  }
   REQUIRE(back.seconds_by_step);
   CHECK(back.seconds_by_step->steps.stellar == 0.5);
   CHECK(back.seconds_by_step->steps.untangle == 0.125);
@@ -125,8 +158,10 @@ TEST_CASE("job document: fields, links only when succeeded, round trip", "[api][
   json old = doc;
   old.erase("thin_parts");
   old.erase("seconds_by_step");
+  old.erase("dual");
   CHECK_FALSE(job_from_json(old).thin_parts);
   CHECK_FALSE(job_from_json(old).seconds_by_step);
+  CHECK_FALSE(job_from_json(old).dual);
 
   json broken = doc;
   broken["state"] = "sleeping";

@@ -87,6 +87,22 @@ TEST_CASE("remeshd: submit raw and multipart, follow, download, list, delete", "
   CHECK(done["thin_parts"]["outside"] == done["latest"]["small"].get<int>() + done["latest"]["big"].get<int>());
   CHECK(done["thin_parts"]["in_thin_parts"] == 0);
   CHECK(done["thin_parts"]["limit"].get<double>() == Approx(0.4 / std::sqrt(3.0)));
+  // The dual of the result: one atom per triangle, one bond per edge, one ring per vertex of the
+  // ball (closed: sum of (6 - sides) = 12), its bonds judged against [0.2, 0.35] / sqrt(3).
+  const json& dual = done["dual"];
+  CHECK(dual["atoms"] == done["latest"]["edges"].get<int>() * 2 / 3);
+  CHECK(dual["bonds"] == done["latest"]["edges"]);
+  int rings = 0, excess = 0;
+  for (const auto& [sides, count] : dual["rings"].items()) {
+    rings += count.get<int>();
+    excess += (6 - std::stoi(sides)) * count.get<int>();
+  }
+  CHECK(rings == done["latest"]["vertices"]);
+  CHECK(excess == 12);
+  CHECK(dual["bond_interval"][0].get<double>() == Approx(0.2 / std::sqrt(3.0)));
+  CHECK(dual["bond_interval"][1].get<double>() == Approx(0.35 / std::sqrt(3.0)));
+  CHECK(dual["bond_length"]["min"].get<double>() <= dual["bond_length"]["mean"].get<double>());
+  CHECK(dual["bonds_inside_fraction"].get<double>() > 0.5);
   // Where the time went: every step of Algorithm 1 took some, none negative, the remeshing call
   // within the job's run, and the steps plus the rest add up to it.
   const json& steps = done["seconds_by_step"];

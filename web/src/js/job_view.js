@@ -22,6 +22,21 @@ function int(v) { return Number.isFinite(v) ? v.toLocaleString('en-US') : '–';
 function num(v) { return Number.isFinite(v) ? String(+v.toPrecision(5)) : '–'; }
 function fixed(v, d) { return Number.isFinite(v) ? v.toFixed(d) : '–'; }
 
+/// The result's dual as an atom lattice (the job's `dual`), one line; '' before it exists.
+/// "dual: 12704 atoms, 19056 bonds · rings 344 × 5, 5680 × 6, 328 × 7 · bond length 0.875 ± 0.0613
+/// (0.524 to 1.21) · 99.3 % inside [0.693, 1.04] = [emin, emax] / √3 (36 short, 106 long)"
+export function dual_text(d) {
+  if (!d) return '';
+  const rings = Object.entries(d.rings || {}).map(([sides, n]) => `${n} × ${sides}`).join(', ');
+  const b = d.bond_length || {};
+  const p = (x) => String(+Number(x).toPrecision(3));
+  let text = `dual: ${d.atoms} atoms, ${d.bonds} bonds · rings ${rings || 'none'} · bond length ${p(b.mean)} ± ${p(b.deviation)} (${p(b.min)} to ${p(b.max)})`;
+  const [lo, hi] = d.bond_interval || [0, 0];
+  if (hi > 0)
+    text += ` · ${(100 * d.bonds_inside_fraction).toFixed(1)} % inside [${p(lo)}, ${p(hi)}] = [emin, emax] / √3 (${d.short_bonds} short, ${d.long_bonds} long)`;
+  return text;
+}
+
 export class JobView {
   /// hooks: on_job(job) after every document refresh, on_end(job) once when the job is final.
   constructor(hooks) {
@@ -206,6 +221,7 @@ export class JobView {
     $('progress-text').title = steps
       ? `seconds by step: ${STEPS.filter((k) => k in steps).map((k) => `${k} ${Number(steps[k]).toFixed(3)}`).join(', ')}`
       : '';
+    $('dual-summary').textContent = dual_text(job.dual);
     document.title = `${FINAL.has(job.state) ? job.state : `${done}/${total}`} · ${job.input?.filename || 'job'} · remeshd`;
     $('cancel').disabled = !(job.state === 'queued' || job.state === 'running');
     if (job.error) this.show_error(typeof job.error === 'string' ? job.error : job.error.detail || JSON.stringify(job.error));
