@@ -173,7 +173,7 @@ int run_remesh(const std::vector<std::string>& args) {
   if (job.dual_out) {
     const PolyMesh dual = trivalent_dual(mesh, &*reference);
     write_mesh_file(to_soup(dual), *job.dual_out);
-    dual_summary = dual_stats(dual, job.params.e_min, job.params.e_max);
+    if (!job.quiet) dual_summary = dual_stats(dual, job.params.e_min, job.params.e_max);  // for the summary only
   }
   if (job.stats_out) {
     const bool json = job.stats_out->size() > 5 && job.stats_out->ends_with(".json");

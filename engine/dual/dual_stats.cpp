@@ -33,7 +33,10 @@ DualStats dual_stats(const PolyMesh& dual, double e_min, double e_max) {
   // Two passes, as the primal statistics (statistics.cpp): no cancellation for long bonds.
   double dev2 = 0;
   for (auto e : dual.edges())
-    if (!dual.status(e).deleted()) dev2 += (dual.calc_edge_length(e) - s.mean) * (dual.calc_edge_length(e) - s.mean);
+    if (!dual.status(e).deleted()) {
+      const double d = dual.calc_edge_length(e) - s.mean;
+      dev2 += d * d;
+    }
   s.deviation = std::sqrt(dev2 / n);
   return s;
 }

@@ -2,7 +2,8 @@
 /// \file dual_stats.h
 /// Not in the thesis: the dual as an atom lattice (carbon: one atom per dual vertex, one bond per
 /// dual edge). What a user of it asks: how many atoms and bonds, how many rings of each size (a
-/// closed surface of genus 0 needs 12 more pentagons than heptagons), and how long the bonds are.
+/// closed surface of genus 0 has sum (6 - k) n_k = 12 over its k-sided rings: with rings of 5, 6
+/// and 7 sides only, 12 more pentagons than heptagons), and how long the bonds are.
 /// For equilateral triangles of side a the dual edge is a / sqrt(3) (ALGORITHM.md), so the bonds
 /// of a primal run in [e_min, e_max] are judged against [e_min, e_max] / sqrt(3).
 

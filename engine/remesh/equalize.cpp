@@ -285,9 +285,12 @@ void untangle_and_mend(TriMesh& mesh, const ReferenceSurface& reference, const P
     PhaseTimer timer(phases.untangle);
     const UntangleCounts u = untangle(mesh, reference, params.e_min, params.e_max, params.threads);
     row.cleanup_fixes += u.moved;
+    // Its flips and collapses count with the row's own, as the cleanup's do (count_cleanup).
+    row.flips += u.flipped;
+    row.collapses += u.collapsed;
     if (u.moved == 0 || round == kUntangleRounds) return;
-    // Nothing to mend when no more edges are outside than before (the vertex moves never take
-    // one out; a flattened disk may).
+    // Nothing to mend when no more edges are outside than before (the vertex moves and flips
+    // never take one out; a collapse may leave a short one, a flattened disk any).
     const IterationStats now = measure(mesh, params.e_min, params.e_max, params.threads);
     if (now.small + now.big <= outside_before) return;
     const std::vector<CrossingKey> left = crossing_keys(mesh, u.left);

@@ -180,7 +180,12 @@ class Untangler {
     std::size_t kept = 0;
     for (auto e : edges_of(mesh_, pairs))
       if (try_flip(e)) ++kept;
-    if (kept > 0) failures_.clear();  // the flipped quads changed their vertices' stars
+    if (kept > 0) {
+      failures_.clear();  // the flipped quads changed their vertices' stars
+      // The flipped faces are no longer where the vertex moves' bound (origins_) says: index
+      // them as they are now, so that drift_ starts again from 0 for the moves that follow.
+      index_faces();
+    }
     return kept;
   }
 
@@ -210,7 +215,10 @@ class Untangler {
   /// corners do not move, so its faces, before and after, lie in the ball around the corners'
   /// centroid that reaches the farthest corner: the faces that can cross them are those
   /// faces_near() finds there. A flip moves the two faces' centroids within that ball, which the
-  /// index does not see: drift_ grows by the ball's diameter.
+  /// index does not see: drift_ grows by the ball's diameter. It grows by the sum, not the
+  /// largest: a face flipped again in the same round moves again from where the last flip left
+  /// it, so only the sum bounds how far it is from where the index saw it (flip_round indexes
+  /// the faces anew after a round that kept a flip, which sets drift_ back to 0).
   bool try_flip(OpenMesh::EdgeHandle e) {
     if (!flip_is_safe(mesh_, e, 0.0, nullptr, /*turned_ok=*/true)) return false;
     const Quad q = quad_of(mesh_, e);
@@ -228,7 +236,7 @@ class Untangler {
     if (before == 0 || crossings_of({{{p[3], p[1], p[2]}, {p[2], p[0], p[3]}}}, faces, near) >= before) return false;
     mesh_.flip(e);
     for (const Vec3& x : p) note_move(x, x);
-    drift_ = std::max(drift_, 2 * radius);
+    drift_ += 2 * radius;
     return true;
   }
 
@@ -588,10 +596,21 @@ class CollapseJudge {
     return {before, before == 0 ? 0 : count(then_)};
   }
 
-  /// Records a collapse of h, before it is carried out.
+  /// Records a collapse of h, before it is carried out. No vertex moves in a collapse round: a
+  /// face's corner that was `gone` becomes `stays`, which may itself have taken in vertices of
+  /// earlier collapses and may be taken in by later ones. reach_[v] bounds how far v lies from
+  /// every vertex merged into it since the index; a face's corners, and so its centroid, lie
+  /// within the largest reach of where the index saw them (a chain of collapses adds up).
   void collapsing(HalfedgeHandle h) {
-    const Vec3 gone = mesh_.point(mesh_.from_vertex_handle(h)), stays = mesh_.point(mesh_.to_vertex_handle(h));
-    drift_ = std::max(drift_, (gone - stays).norm());
+    const VertexHandle gone = mesh_.from_vertex_handle(h), stays = mesh_.to_vertex_handle(h);
+    const auto reach_of = [&](VertexHandle v) {
+      const auto it = reach_.find(v.idx());
+      return it == reach_.end() ? 0.0 : it->second;
+    };
+    const double reach =
+        std::max(reach_of(stays), reach_of(gone) + (mesh_.point(gone) - mesh_.point(stays)).norm());
+    reach_[stays.idx()] = reach;
+    drift_ = std::max(drift_, reach);
   }
 
  private:
@@ -619,6 +638,7 @@ class CollapseJudge {
   const FaceSpheres spheres_;
   const PointIndex index_;
   double drift_ = 0;
+  std::unordered_map<int, double> reach_;  ///< collapsing(): per vertex that took in others
   std::vector<std::uint32_t> near_;
   std::vector<FaceHandle> star_;  ///< sorted
   std::vector<Triangle> now_, then_;

@@ -51,8 +51,10 @@ struct UntangleCounts {
 };
 
 /// Moves the vertices of crossing faces of `mesh` apart, flips and collapses their edges (see the
-/// file comment). The mesh stays valid, without deleted elements: no face folds or degenerates, the
-/// topology and the boundary do not change.
+/// file comment). The mesh stays valid, without deleted elements, and the topology and the boundary
+/// do not change. No vertex move folds a face; flips and collapses may turn faces that are turned
+/// already in the tangle (their normals need not agree with the old ones), but never make a pair
+/// of adjacent faces sharper than geom::adjacent_ok allows.
 UntangleCounts untangle(TriMesh& mesh, const ReferenceSurface& reference, double e_min, double e_max,
                         unsigned threads);
 

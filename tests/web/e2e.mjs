@@ -115,8 +115,8 @@ async function main() {
   check(/^seconds by step: stellar [\d.]+, flips [\d.]+, .*total [\d.]+$/.test(steps_title || ''), `time by step shown once succeeded (${steps_title})`);
   const dual_line = await page.textContent('#dual-summary');
   const job_doc = await (await fetch(`${base}/api/v1/jobs/${job_id}`)).json();
-  check(job_doc.dual && dual_line.startsWith(`dual: ${job_doc.dual.atoms} atoms, ${job_doc.dual.bonds} bonds · rings `) &&
-    / % inside \[[\d.]+, [\d.]+\] = \[emin, emax\] \/ √3 \(\d+ short, \d+ long\)$/.test(dual_line),
+  check(job_doc.dual && dual_line.startsWith(`dual: ${job_doc.dual.atoms.toLocaleString('en-US')} atoms, ${job_doc.dual.bonds.toLocaleString('en-US')} bonds · rings `) &&
+    / % inside \[[\d.]+, [\d.]+\] = \[emin, emax\] \/ √3 \([\d,]+ short, [\d,]+ long\)$/.test(dual_line),
     `the dual's atoms, rings and bonds shown once succeeded (${dual_line})`);
   const summary_text = await page.textContent('#summary');
   check(/server summary/.test(summary_text) && /genus/.test(summary_text), 'server summary with genus replaces the local one');

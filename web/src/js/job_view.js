@@ -23,17 +23,18 @@ function num(v) { return Number.isFinite(v) ? String(+v.toPrecision(5)) : '–';
 function fixed(v, d) { return Number.isFinite(v) ? v.toFixed(d) : '–'; }
 
 /// The result's dual as an atom lattice (the job's `dual`), one line; '' before it exists.
-/// "dual: 12704 atoms, 19056 bonds · rings 344 × 5, 5680 × 6, 328 × 7 · bond length 0.875 ± 0.0613
+/// "dual: 12,704 atoms, 19,056 bonds · rings 344 × 5, 5,680 × 6, 328 × 7 · bond length 0.875 ± 0.0613
 /// (0.524 to 1.21) · 99.3 % inside [0.693, 1.04] = [emin, emax] / √3 (36 short, 106 long)"
 export function dual_text(d) {
   if (!d) return '';
-  const rings = Object.entries(d.rings || {}).map(([sides, n]) => `${n} × ${sides}`).join(', ');
+  const rings = Object.entries(d.rings || {}).map(([sides, n]) => `${int(n)} × ${sides}`).join(', ');
   const b = d.bond_length || {};
-  const p = (x) => String(+Number(x).toPrecision(3));
-  let text = `dual: ${d.atoms} atoms, ${d.bonds} bonds · rings ${rings || 'none'} · bond length ${p(b.mean)} ± ${p(b.deviation)} (${p(b.min)} to ${p(b.max)})`;
+  // Three significant digits; a missing length shows as '–', not NaN.
+  const p = (x) => (x == null || !Number.isFinite(Number(x)) ? '–' : String(+Number(x).toPrecision(3)));
+  let text = `dual: ${int(d.atoms)} atoms, ${int(d.bonds)} bonds · rings ${rings || 'none'} · bond length ${p(b.mean)} ± ${p(b.deviation)} (${p(b.min)} to ${p(b.max)})`;
   const [lo, hi] = d.bond_interval || [0, 0];
   if (hi > 0)
-    text += ` · ${(100 * d.bonds_inside_fraction).toFixed(1)} % inside [${p(lo)}, ${p(hi)}] = [emin, emax] / √3 (${d.short_bonds} short, ${d.long_bonds} long)`;
+    text += ` · ${fixed(100 * d.bonds_inside_fraction, 1)} % inside [${p(lo)}, ${p(hi)}] = [emin, emax] / √3 (${int(d.short_bonds)} short, ${int(d.long_bonds)} long)`;
   return text;
 }
 
@@ -78,6 +79,7 @@ export class JobView {
     this.draw_rows();
     $('job-id').textContent = id;
     $('job-error').textContent = '';
+    $('dual-summary').textContent = '';  // the last job's, until this one's document arrives
     try {
       this.set_job(await api.get_job(id));
       const rows = await api.get_stats(id);
