@@ -184,6 +184,7 @@ json job_to_json(const JobRecord& job, std::string_view prefix, double now) {
       {"seconds_by_step", job.seconds_by_step ? step_seconds_to_json(*job.seconds_by_step) : json(nullptr)},
       {"dual", job.dual ? dual_to_json(*job.dual) : json(nullptr)},
       {"error", job.error ? json(*job.error) : json(nullptr)},
+      {"attempts", job.attempts},
       {"timings",
        {{"queued_seconds", std::max(0.0, queued_end - job.created_at)},
         {"run_seconds", std::max(0.0, run_seconds)}}},
@@ -227,6 +228,7 @@ JobRecord job_from_json(const json& j) {
     // Absent in documents written before the field existed.
     if (const auto d = j.find("dual"); d != j.end() && !d->is_null()) job.dual = dual_from_json(*d);
     if (!j.at("error").is_null()) job.error = j.at("error").get<std::string>();
+    job.attempts = j.value("attempts", 0);  // absent in documents written before the field existed
     return job;
   } catch (const json::exception& e) {
     throw std::runtime_error(std::string("job document: ") + e.what());

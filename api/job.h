@@ -61,7 +61,15 @@ struct JobRecord {
   /// against [e_min, e_max] / sqrt(3); nullopt until the job succeeded.
   std::optional<DualStats> dual;
   std::optional<std::string> error;
+  /// Runs started. Counted when a run starts and taken back when the service stops it on shutdown:
+  /// a run the process did not live through (a crash, a kill) stays counted, and a job counted
+  /// kMaxAttempts times is not run again on restart (it fails, named so), so that an input that
+  /// crashes the engine cannot take the service down at every start.
+  int attempts = 0;
 };
+
+/// Runs of a job the service starts at most (JobRecord::attempts).
+inline constexpr int kMaxAttempts = 2;
 
 /// The public job document (see api/openapi.yaml, schema Job). `prefix` is the API root
 /// ("/api/v1"); `now` (Unix seconds) closes open timing intervals.

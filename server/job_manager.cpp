@@ -44,7 +44,7 @@ void JobManager::transition(Job& job, JobState state) {
   JobState from = r.state;
   r.state = state;
   double now = now_seconds();
-  if (state == JobState::Running) r.started_at = now;
+  if (state == JobState::Running) r.started_at = now, ++r.attempts;
   if (remesh::api::is_final(state)) {
     r.finished_at = now;
     metrics_.count_job_finished(std::string(state_name(state)));
@@ -87,6 +87,17 @@ void JobManager::start() {
         for (std::size_t i = 0; i < job->rows.size(); ++i)
           job->events.push_back({JobEvent::Kind::Iteration, r.state, i});
         job->events.push_back({JobEvent::Kind::State, r.state, 0});
+      } else if (r.attempts >= remesh::api::kMaxAttempts) {
+        // The process ended during each of its runs, and not by a shutdown: the input may crash
+        // the engine. Failed, not run again (JobRecord::attempts).
+        r.state = JobState::Failed;
+        r.error = "the service stopped " + std::to_string(r.attempts) +
+                  " times while running this job (a crash or a kill); it is not run again";
+        r.finished_at = now_seconds();
+        persist(r);
+        log_.warn("job", {str("job", r.id), str("to", "failed"), str("error", *r.error)});
+        job->events.push_back({JobEvent::Kind::State, JobState::Queued, 0});
+        job->events.push_back({JobEvent::Kind::State, JobState::Failed, 0});
       } else {  // accepted but not finished: run it (again) from the start
         r.state = JobState::Queued;
         r.started_at.reset();
@@ -194,6 +205,9 @@ void JobManager::run(const std::string& id) {
     std::lock_guard lock(mutex_);
     --busy_;
     if (job->interrupted && job->record.state != JobState::Cancelling) {
+      // Stopped by the shutdown, not lost to a crash: this run does not count (JobRecord::attempts).
+      --job->record.attempts;
+      persist(job->record);
       log_.info("job", {str("job", id), str("interrupted", "shutdown"), str("state", "running (re-queued on start)")});
       return;
     }

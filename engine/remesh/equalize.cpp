@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <string>
@@ -95,6 +96,9 @@ double main_phase_sigma(const Params& params) {
 /// Scaling sigma by m_i / m instead changed the runs from 2x to 5x as well, with no better
 /// outcome (regular vertices 6-9 points lower on spot, bunny and kitten at k=6).
 constexpr double kMaxBandShare = 0.5;
+
+/// See crease_spacing() (equalize.h).
+constexpr double kMinCreaseSpacing = 0.25;
 double band_at(double sigma, double m_i) { return std::min(sigma, kMaxBandShare * m_i); }
 
 /// Flip sweeps per iteration: the thesis does one; further sweeps catch the flips the first one
@@ -321,6 +325,7 @@ IterationStats measured_row(const TriMesh& mesh, const Params& params, const Ite
 void check_preconditions(const TriMesh& mesh, const Params& params) {
   if (auto errors = check(params); !errors.empty()) throw ParamsError(std::move(errors));
   if (mesh.n_faces() == 0) throw MeshError("the mesh has no faces");
+  if (auto errors = check_against(mesh, params); !errors.empty()) throw ParamsError(std::move(errors));
   const std::size_t estimate = estimate_output_faces(mesh, params);
   if (params.max_output_faces > 0 && estimate > params.max_output_faces)
     throw LimitError("estimated output of " + std::to_string(estimate) + " faces exceeds the limit of " +
@@ -391,6 +396,34 @@ const char* outcome_name(Outcome o) {
   return "completed";
 }
 
+double bounding_box_diagonal(const TriMesh& mesh) {
+  Vec3 lo(std::numeric_limits<double>::max()), hi(std::numeric_limits<double>::lowest());
+  bool any = false;
+  for (auto v : mesh.vertices()) {
+    lo.minimize(mesh.point(v));
+    hi.maximize(mesh.point(v));
+    any = true;
+  }
+  return any ? (hi - lo).norm() : 0.0;
+}
+
+std::vector<FieldError> check_against(const TriMesh& mesh, const Params& params) {
+  std::vector<FieldError> errors;
+  const double diagonal = bounding_box_diagonal(mesh);
+  if (std::isfinite(params.e_min) && std::isfinite(diagonal) && params.e_min >= diagonal) {
+    char text[160];
+    std::snprintf(text, sizeof text,
+                  "must be shorter than the mesh's bounding-box diagonal, %.6g: no edge on its surface is longer",
+                  diagonal);
+    errors.push_back({"emin", text});
+  }
+  return errors;
+}
+
+double crease_spacing(const Params& params) {
+  return std::max(params.e_min, kMinCreaseSpacing * 0.5 * (params.e_min + params.e_max));
+}
+
 std::size_t estimate_output_faces(const TriMesh& mesh, const Params& params) {
   const double m = 0.5 * (params.e_min + params.e_max);
   if (!(m > 0) || !std::isfinite(m)) return 0;
@@ -399,8 +432,11 @@ std::size_t estimate_output_faces(const TriMesh& mesh, const Params& params) {
   return static_cast<std::size_t>(std::ceil(faces));
 }
 
-Result equalize(TriMesh& mesh, const Params& params, const OnIteration& on_iteration, std::stop_token stop) {
-  check_preconditions(mesh, params);
+Result equalize(TriMesh& mesh, const Params& requested, const OnIteration& on_iteration, std::stop_token stop) {
+  check_preconditions(mesh, requested);
+  // e_max at most the bounding-box diagonal (equalize.h): the same edges are inside either way.
+  Params params = requested;
+  params.e_max = std::min(params.e_max, bounding_box_diagonal(mesh));
   const auto start = Clock::now();
   const unsigned threads = params.threads;
   const double m = 0.5 * (params.e_min + params.e_max);
@@ -414,7 +450,7 @@ Result equalize(TriMesh& mesh, const Params& params, const OnIteration& on_itera
   if (mesh.n_vertices() >= kOrderMinVertices) order_in_space(mesh, neighbour_caches, threads);
   std::size_t renumbered_since = 0;  // splits and collapses since (kOrderShare)
   auto reference = std::make_unique<ReferenceSurface>(mesh);
-  auto features = std::make_unique<FeatureSnap>(mesh, params.e_min);
+  auto features = std::make_unique<FeatureSnap>(mesh, crease_spacing(params));
   setup_timer.stop();
 
   std::vector<IterationStats> history;  // the row of each iteration (plateaued)
@@ -446,7 +482,7 @@ Result equalize(TriMesh& mesh, const Params& params, const OnIteration& on_itera
     if (params.relax_every > 0 && i % params.relax_every == 0) {
       const PhaseTimer timer(phases.setup);
       reference = std::make_unique<ReferenceSurface>(mesh);
-      features = std::make_unique<FeatureSnap>(mesh, params.e_min);
+      features = std::make_unique<FeatureSnap>(mesh, crease_spacing(params));
     }
 
     // Algorithms 2 and 3: stellar operations on the priority list.

@@ -16,6 +16,7 @@
 #include <functional>
 #include <stop_token>
 #include <string>
+#include <vector>
 
 #include "core/mesh.h"
 #include "remesh/params.h"
@@ -108,9 +109,27 @@ struct Result {
 /// Estimated face count of the output: area / (sqrt(3)/4 * m^2), m = (e_min + e_max) / 2.
 std::size_t estimate_output_faces(const TriMesh& mesh, const Params& params);
 
+/// The spacing of the feature snap's points along the reference's creases (feature_snap.h): e_min,
+/// but never less than a quarter of m = (e_min + e_max) / 2. With [1.2, 1.8] it is e_min; an
+/// interval like [1e-7, 1] would otherwise put a point every 1e-7 along every crease, hundreds of
+/// millions of them before the first iteration (a unit cube: 8 GB), for a mesh whose edges are
+/// near 0.5.
+double crease_spacing(const Params& params);
+
+/// Length of the diagonal of the box around the mesh's vertices (0 for an empty mesh).
+double bounding_box_diagonal(const TriMesh& mesh);
+
+/// What check(params) cannot judge without the mesh: e_min must be shorter than the mesh's
+/// bounding-box diagonal, since no edge between two points of its surface is longer (no edge could
+/// end inside the interval). Every invalid field, named as check() names them; empty when valid.
+std::vector<FieldError> check_against(const TriMesh& mesh, const Params& params);
+
 /// Remeshes `mesh` in place. Preconditions: a valid 2-manifold, consistently oriented TriMesh (as
-/// read_mesh returns). Throws ParamsError if check(params) fails, LimitError if the estimated output
-/// exceeds params.max_output_faces. `on_iteration` runs on the calling thread after each iteration.
+/// read_mesh returns). Throws ParamsError if check(params) or check_against(mesh, params) fails,
+/// LimitError if the estimated output exceeds params.max_output_faces. An e_max beyond the mesh's
+/// bounding-box diagonal is taken as the diagonal: no edge on the surface is longer, so the same
+/// edges are inside, and the steps that aim at (e_min + e_max) / 2 aim at a length the surface has
+/// (an e_max of 1e300 made eq. 3.1 overflow to NaN positions). `on_iteration` runs on the calling thread after each iteration.
 /// A stop request is honoured between phases; the mesh is valid whenever this returns.
 Result equalize(TriMesh& mesh, const Params& params, const OnIteration& on_iteration = {},
                 std::stop_token stop = {});

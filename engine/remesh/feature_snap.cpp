@@ -40,6 +40,8 @@ constexpr std::size_t kSnapBudgetPer = 50, kSnapBudgetMin = 64;
 /// grows with the angle's tangent).
 const double kCreaseCos = std::cos(20.0 * std::acos(-1.0) / 180.0);
 
+constexpr double kMaxCreaseParts = 1 << 16;
+
 /// The interior reference vertices and, with a spacing, points along the creases (see the header).
 std::vector<Vec3> feature_points(const TriMesh& reference, double crease_spacing) {
   std::vector<Vec3> points;
@@ -58,8 +60,10 @@ std::vector<Vec3> feature_points(const TriMesh& reference, double crease_spacing
     const Vec3& n1 = normals[reference.opposite_face_handle(h).idx()];
     // A degenerate face has no direction to disagree with.
     if (n0.sqrnorm() == 0 || n1.sqrnorm() == 0 || geom::normals_agree(n0, n1, kCreaseCos)) continue;
-    const int parts = static_cast<int>(std::ceil(length / crease_spacing));
-    for (int k = 1; k < parts; ++k) points.push_back(a + (static_cast<double>(k) / parts) * (b - a));
+    // At most kMaxCreaseParts points an edge, whatever the spacing (the cast of a larger count
+    // would overflow; the run's spacing keeps far below it, crease_spacing in equalize.h).
+    const double parts = std::min(std::ceil(length / crease_spacing), kMaxCreaseParts);
+    for (double k = 1; k < parts; ++k) points.push_back(a + (k / parts) * (b - a));
   }
   return points;
 }

@@ -342,16 +342,19 @@ std::size_t ReferenceSurface::nearest_vertices(const Vec3& p, std::size_t k, std
   return impl_->nearest(p, out, k);
 }
 
+// A point that is not finite (an overflow upstream) has no nearest vertices: it is returned as it is,
+// for the caller's checks to refuse, instead of a read past the kd-tree's empty answer.
 Vec3 ReferenceSurface::closest_point(const Vec3& p, const Vec3& normal_hint) const {
   std::uint32_t idx[Impl::kMaxK];
   const std::size_t found = impl_->nearest(p, idx, impl_->neighbours);
-  return impl_->closest_point(p, normal_hint, idx, found);
+  return found == 0 ? p : impl_->closest_point(p, normal_hint, idx, found);
 }
 
 Vec3 ReferenceSurface::closest_point(const Vec3& p, const Vec3& normal_hint, NeighbourCache& cache) const {
+  if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2])) return p;
   std::uint32_t idx[Impl::kMaxK];
   const std::size_t found = impl_->nearest(p, idx, cache);
-  return impl_->closest_point(p, normal_hint, idx, found);
+  return found == 0 ? p : impl_->closest_point(p, normal_hint, idx, found);
 }
 
 /// The closest point to p on the triangles incident to the reference vertices idx[0..found) (folded

@@ -99,6 +99,16 @@ TEST_CASE("prepare_job: the errors it must give", "[api][upload]") {
       CHECK_FALSE(e.errors().empty());
     }
   }
+  SECTION("an emin no edge of the mesh can reach (its bounding-box diagonal is about 3.5)") {
+    try {
+      prepare_job(obj, "x.obj", Format::Obj, params({{"emin", 5}, {"emax", 1e300}}), {});
+      FAIL("no ParamsError");
+    } catch (const ParamsError& e) {
+      CHECK(fields_of(e) == std::set<std::string>{"emin"});
+      CHECK(std::string(e.errors().front().message).find("bounding-box diagonal") != std::string::npos);
+    }
+    CHECK_NOTHROW(prepare_job(obj, "x.obj", Format::Obj, params({{"emin", 0.2}, {"emax", 1e300}}), {}));
+  }
   SECTION("iterations over the service limit") {
     UploadLimits limits;
     limits.max_iterations = 2;

@@ -249,10 +249,42 @@ TEST_CASE("remeshd: restart after SIGKILL keeps finished jobs and completes the 
   json done = wait_final(c, interrupted, 90);
   CHECK(done["state"] == "succeeded");
   CHECK(done["progress"]["iteration"] == expected_iterations);
+  CHECK(done["attempts"] == 2);  // the killed run counts
+  CHECK(f["attempts"] == 1);
   auto rows = json::parse(c.Get(("/api/v1/jobs/" + interrupted + "/stats").c_str())->body)["rows"];
   CHECK(rows.size() == static_cast<std::size_t>(expected_iterations));
   CHECK(rows[0]["iteration"] == 1);
   CHECK(c.Get(("/api/v1/jobs/" + interrupted + "/result?mesh=dual&format=glb").c_str())->status == 200);
+}
+
+TEST_CASE("remeshd: a job whose runs the process does not live through twice fails instead of running again",
+          "[server][restart]") {
+  // As a job that crashes the engine would: the daemon dies during its run, twice. On the next
+  // start it is failed, named so, and the other jobs run; it is never run a third time.
+  TempDir tmp;
+  const auto data = tmp.path / "data";
+  std::string poison, other;
+  for (int run = 1; run <= 2; ++run) {
+    Daemon d(data, {"--workers", "1"});
+    auto c = d.client();
+    if (run == 1) {
+      poison = submit(c, sphere_obj(4), kLong);
+      other = submit(c, sphere_obj(2), kShort);  // queued behind it
+    }
+    const json j = wait_job(c, poison, running_with_rows);
+    CHECK(j["attempts"] == run);
+    CHECK(d.stop(SIGKILL) == 128 + SIGKILL);
+  }
+  Daemon d(data, {"--workers", "1"});
+  auto c = d.client();
+  const json failed = get_job(c, poison);
+  CHECK(failed["state"] == "failed");
+  CHECK(failed["attempts"] == 2);
+  CHECK(failed["error"].get<std::string>().find("stopped 2 times") != std::string::npos);
+  CHECK(wait_final(c, other, 60)["state"] == "succeeded");
+  CHECK(get_job(c, poison)["state"] == "failed");  // still: not re-queued
+  auto events = read_events(d.port(), "/api/v1/jobs/" + poison + "/events");
+  CHECK(events.events.back().event == "end");
 }
 
 TEST_CASE("remeshd: SIGTERM interrupts running jobs without losing them; expiry", "[server][restart]") {
@@ -283,7 +315,9 @@ TEST_CASE("remeshd: SIGTERM interrupts running jobs without losing them; expiry"
     // A TTL of ~2 s: the job runs again to the end, then expires.
     Daemon again(data, {"--workers", "1", "--job-ttl-hours", "0.0005"});
     auto c = again.client();
-    CHECK(wait_final(c, id, 90)["state"] == "succeeded");
+    const json done = wait_final(c, id, 90);
+    CHECK(done["state"] == "succeeded");
+    CHECK(done["attempts"] == 1);  // the run the shutdown stopped does not count
     bool gone = false;
     for (int i = 0; i < 300 && !gone; ++i) {
       gone = c.Get(("/api/v1/jobs/" + id).c_str())->status == 404;

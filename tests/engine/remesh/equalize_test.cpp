@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "remesh/equalize.h"
+#include "remesh/feature_snap.h"
 #include "remesh/geometry.h"
 #include "remesh/self_intersections.h"
 #include "support/mesh_generators.h"
@@ -414,4 +415,83 @@ TEST_CASE("a horn's apex stays near the remeshed surface, its edges inside the i
     CHECK(last.small + last.big == 0);
     CHECK(test::brute_distance(mesh, Vec3(0, 0, 10.0)) < 1.5);
   }
+}
+
+TEST_CASE("intervals far beyond the mesh's size are refused or taken as its size, never overflow", "[equalize]") {
+  // A sphere of radius 5 (bounding-box diagonal about 17.3) with mean edge about 1.2.
+  for (const TriMesh& input : {test::make_icosphere(3, 5.0), test::make_torus(24, 12, 6.0, 2.0)}) {
+    const double diagonal = bounding_box_diagonal(input);
+    REQUIRE(diagonal > 10);
+    // e_max far past the mesh (1e300: its square overflows): every edge is inside, the run converges
+    // at once and returns a finite, valid mesh.
+    for (double e_max : {1e300, 1e160, 1e6}) {
+      INFO("e_max " << e_max);
+      TriMesh mesh = input;
+      Params p;
+      p.e_min = 0.05;
+      p.e_max = e_max;
+      const Result r = equalize(mesh, p);
+      CHECK(r.outcome == Outcome::Converged);
+      CHECK(test::check_mesh_valid(mesh) == "");
+      for (auto v : mesh.vertices())
+        for (int k = 0; k < 3; ++k) CHECK(std::isfinite(mesh.point(v)[k]));
+      CHECK(test::plain_inside_fraction(mesh, p.e_min, p.e_max) == 1.0);
+    }
+    // e_max beyond the diagonal but e_min a real target: coarsened as far as the surface allows,
+    // every edge at least e_min, positions finite.
+    {
+      TriMesh mesh = input;
+      Params p;
+      p.e_min = 3.0;
+      p.e_max = 1e300;
+      equalize(mesh, p);
+      CHECK(test::check_mesh_valid(mesh) == "");
+      CHECK(mesh.n_vertices() < input.n_vertices());
+      for (auto v : mesh.vertices())
+        for (int k = 0; k < 3; ++k) CHECK(std::isfinite(mesh.point(v)[k]));
+    }
+    // e_min at or past the diagonal: no edge on the surface can be that long; refused, emin named.
+    for (double e_min : {diagonal, 2 * diagonal, 1e200}) {
+      TriMesh mesh = input;
+      Params p;
+      p.e_min = e_min;
+      p.e_max = 2 * e_min;
+      CHECK(check(p).empty());
+      const std::vector<FieldError> errors = check_against(mesh, p);
+      REQUIRE(errors.size() == 1);
+      CHECK(errors[0].field == "emin");
+      CHECK_THROWS_AS(equalize(mesh, p), ParamsError);
+    }
+    Params ok;
+    ok.e_min = 0.5 * diagonal;
+    ok.e_max = diagonal;
+    CHECK(check_against(input, ok).empty());
+  }
+}
+
+TEST_CASE("a tiny e_min does not flood the feature snap with crease points", "[equalize]") {
+  // A cube (creases of 90 degrees, edges 10 long) at [1e-9, 2]: the crease points are spaced by at
+  // least a quarter of (e_min + e_max) / 2, not by e_min (which would make 10^10 of them).
+  TriMesh mesh;
+  std::vector<TriMesh::VertexHandle> v;
+  for (int i = 0; i < 8; ++i) v.push_back(mesh.add_vertex(Vec3(10.0 * (i & 1), 10.0 * ((i >> 1) & 1), 10.0 * ((i >> 2) & 1))));
+  const int quads[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
+  for (const auto& q : quads) {
+    mesh.add_face(v[q[0]], v[q[1]], v[q[2]]);
+    mesh.add_face(v[q[0]], v[q[2]], v[q[3]]);
+  }
+  REQUIRE(test::check_mesh_valid(mesh) == "");
+  Params p;
+  p.e_min = 1e-9;
+  p.e_max = 2.0;
+  CHECK(crease_spacing(p) >= 0.25 * 1.0);  // a quarter of m, not e_min
+  CHECK(FeatureSnap(mesh, crease_spacing(p)).size() < 1000);
+  Params thesis = table_4_2();
+  CHECK(crease_spacing(thesis) == thesis.e_min);  // the Table 4.2 runs keep e_min
+  const Result r = equalize(mesh, p);
+  CHECK(r.outcome != Outcome::Cancelled);
+  CHECK(test::check_mesh_valid(mesh) == "");
+  CHECK(test::euler_characteristic(mesh) == 2);
+  // Every edge is at most e_max (none can be below 1e-9 but a degenerate one, which validity rules out).
+  CHECK(test::plain_inside_fraction(mesh, p.e_min, p.e_max) > 0.95);
 }
