@@ -53,6 +53,32 @@ std::optional<Format> resolve_format(std::string_view format_param, std::string_
   return format_from_content_type(content_type);
 }
 
+std::string utf8_prefix(std::string_view text, std::size_t max_bytes) {
+  static constexpr std::string_view kReplacement = "\xEF\xBF\xBD";  // U+FFFD
+  std::string out;
+  for (std::size_t i = 0; i < text.size();) {
+    const auto b = static_cast<unsigned char>(text[i]);
+    // The length of the sequence b begins, and the range its second byte must lie in (RFC 3629:
+    // no overlong forms, no surrogates, nothing past U+10FFFF).
+    std::size_t n = 0;
+    unsigned char lo = 0x80, hi = 0xBF;
+    if (b < 0x80) n = 1;
+    else if (b >= 0xC2 && b <= 0xDF) n = 2;
+    else if (b >= 0xE0 && b <= 0xEF) n = 3, lo = b == 0xE0 ? 0xA0 : 0x80, hi = b == 0xED ? 0x9F : 0xBF;
+    else if (b >= 0xF0 && b <= 0xF4) n = 4, lo = b == 0xF0 ? 0x90 : 0x80, hi = b == 0xF4 ? 0x8F : 0xBF;
+    bool valid = n > 0 && i + n <= text.size();
+    for (std::size_t k = 1; valid && k < n; ++k) {
+      const auto c = static_cast<unsigned char>(text[i + k]);
+      valid = k == 1 ? c >= lo && c <= hi : c >= 0x80 && c <= 0xBF;
+    }
+    const std::string_view piece = valid ? text.substr(i, n) : kReplacement;
+    if (out.size() + piece.size() > max_bytes) break;
+    out += piece;
+    i += valid ? n : 1;
+  }
+  return out;
+}
+
 std::string safe_stem(std::string_view filename) {
   auto slash = filename.find_last_of("/\\");
   if (slash != std::string_view::npos) filename.remove_prefix(slash + 1);
@@ -96,7 +122,7 @@ PreparedJob prepare_job(std::string_view bytes, std::string_view filename, std::
   r.created_at = now_seconds();
   r.params = params.params;
   r.weld = params.weld;
-  r.filename = std::string(filename.substr(0, 200));
+  r.filename = utf8_prefix(filename, 200);
   r.format = std::string(format_name(job.mesh.format));
   r.bytes = bytes.size();
   r.summary = summarize(job.mesh.mesh);

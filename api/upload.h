@@ -29,6 +29,11 @@ std::optional<Format> resolve_format(std::string_view format_param, std::string_
 /// [A-Za-z0-9._-] kept (others become '_'), at most 80 characters; "mesh" when nothing is left.
 std::string safe_stem(std::string_view filename);
 
+/// `text` as valid UTF-8 of at most `max_bytes` bytes: each byte that does not begin a valid
+/// sequence becomes U+FFFD, and the text is cut between characters (a job's filename is shown and
+/// stored as JSON, which must be UTF-8: "%FF.obj" used to give a 500).
+std::string utf8_prefix(std::string_view text, std::size_t max_bytes);
+
 /// Limits of the service (0 = none).
 struct UploadLimits {
   std::size_t max_faces = 0;          ///< faces of the input

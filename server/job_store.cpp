@@ -20,6 +20,10 @@ using remesh::api::JobRecord;
 
 namespace {
 
+/// A job document holds text users sent (its filename, sanitised at upload): should any of it not
+/// be UTF-8, the bad bytes become U+FFFD instead of an exception (a 500) when it is written.
+constexpr auto kReplaceBadUtf8 = nlohmann::json::error_handler_t::replace;
+
 [[noreturn]] void fail(const std::string& what, const fs::path& path) {
   throw std::runtime_error(what + " " + path.string() + ": " + std::strerror(errno));
 }
@@ -121,7 +125,7 @@ void JobStore::create(const JobRecord& job, std::string_view upload) {
   try {
     fs::create_directories(tmp);
     write_file_atomic(tmp / "upload", upload);
-    write_file_atomic(tmp / "state.json", remesh::api::job_to_json(job, "/api/v1", job.created_at).dump());
+    write_file_atomic(tmp / "state.json", remesh::api::job_to_json(job, "/api/v1", job.created_at).dump(-1, ' ', false, kReplaceBadUtf8));
     write_file_atomic(tmp / "stats.jsonl", "");
     fs::rename(tmp, final_dir);
     fsync_dir(root_);
@@ -133,7 +137,7 @@ void JobStore::create(const JobRecord& job, std::string_view upload) {
 
 void JobStore::save_state(const JobRecord& job) {
   write_file_atomic(dir(job.id) / "state.json",
-                    remesh::api::job_to_json(job, "/api/v1", remesh::api::now_seconds()).dump());
+                    remesh::api::job_to_json(job, "/api/v1", remesh::api::now_seconds()).dump(-1, ' ', false, kReplaceBadUtf8));
 }
 
 void JobStore::append_stats(const std::string& id, const remesh::IterationStats& row) {

@@ -112,7 +112,8 @@ AccessorView view_of(const tinygltf::Model& model, int index, const std::string&
 class Collector {
  public:
   Collector(const tinygltf::Model& model, const ReadOptions& options, std::size_t input_bytes)
-      : model_(model), options_(options), max_points_(std::max<std::size_t>(64 * input_bytes, 1 << 20)) {}
+      : model_(model), options_(options), max_points_(std::max<std::size_t>(64 * input_bytes, 1 << 20)),
+        max_triangles_(std::max<std::size_t>(16 * input_bytes, 1 << 22)) {}
 
   void node(int index, const Mat4& parent, int depth) {
     if (index < 0 || static_cast<std::size_t>(index) >= model_.nodes.size())
@@ -188,6 +189,12 @@ class Collector {
       for (std::size_t i = 0; i < pv.count; ++i) idx.push_back(static_cast<std::int64_t>(first + i));
     }
     const bool flip = det3(m) < 0;
+    // Instancing multiplies the triangles too (a node listing the same child twice, 16 levels deep:
+    // a 300 KB file expanded to 3.3e9 triangles, 4 GB and counting): the same kind of cap.
+    const std::size_t per_face = mode == TINYGLTF_MODE_TRIANGLES ? 3 : 1;
+    if (soup_.face_count() + idx.size() / per_face > max_triangles_)
+      fail("glTF: the scene expands to more than " + std::to_string(max_triangles_) +
+           " triangles (its nodes instance the same meshes over and over)");
     auto add = [&](std::int64_t a, std::int64_t b, std::int64_t c) {
       check_face_limit(soup_.face_count() + 1, options_, "glTF");
       if (flip) std::swap(b, c);
@@ -211,7 +218,43 @@ class Collector {
   RawSoup soup_;
   std::size_t visits_ = 0;
   std::size_t max_points_;
+  std::size_t max_triangles_;  ///< what the scene may expand to (instancing)
 };
+
+/// How deep arrays and objects nest in a JSON text (strings skipped), stopping once past `limit`.
+/// tinygltf's parser recurses once a level: a 40 KB file of 20 000 nested brackets in "extras"
+/// overflowed the stack (the service process died on the upload).
+std::size_t json_depth(std::string_view text, std::size_t limit) {
+  std::size_t depth = 0, deepest = 0;
+  bool in_string = false;
+  for (std::size_t i = 0; i < text.size(); ++i) {
+    const char c = text[i];
+    if (in_string) {
+      if (c == '\\') ++i;
+      else if (c == '"') in_string = false;
+    } else if (c == '"') {
+      in_string = true;
+    } else if (c == '[' || c == '{') {
+      deepest = std::max(deepest, ++depth);
+      if (deepest > limit) break;
+    } else if ((c == ']' || c == '}') && depth > 0) {
+      --depth;
+    }
+  }
+  return deepest;
+}
+
+/// Deepest nesting of the glTF JSON accepted (a glTF document itself needs about 6 levels).
+constexpr std::size_t kMaxJsonDepth = 256;
+
+/// The JSON text of a .gltf file, or of a GLB's first chunk (whatever its header says, within the file).
+std::string_view json_text(std::string_view bytes, bool binary) {
+  if (!binary) return bytes;
+  if (bytes.size() < 20) return {};
+  ByteReader r(bytes, 12);
+  const std::uint32_t length = r.read<std::uint32_t>(false);
+  return bytes.substr(20, std::min<std::size_t>(length, bytes.size() - 20));
+}
 
 std::string first_line(const std::string& s) {
   std::string t = s.substr(0, s.find('\n'));
@@ -228,6 +271,9 @@ RawSoup read_gltf(std::string_view bytes, bool binary, const ReadOptions& option
     const std::uint32_t version = r.read<std::uint32_t>(false);
     if (version != 2) fail("GLB: version " + std::to_string(version) + " (only glTF 2.0 is supported)");
   }
+  if (json_depth(json_text(bytes, binary), kMaxJsonDepth) > kMaxJsonDepth)
+    fail(std::string(binary ? "GLB" : "glTF") + ": its JSON nests arrays and objects more than " +
+         std::to_string(kMaxJsonDepth) + " levels deep");
   FsGuard guard;
   tinygltf::TinyGLTF loader;
   loader.SetImageLoader(&skip_image, nullptr);

@@ -134,3 +134,31 @@ TEST_CASE("prepare_job: the errors it must give", "[api][upload]") {
                     LimitError);
   }
 }
+
+TEST_CASE("utf8_prefix: filenames become valid UTF-8, cut between characters", "[api][upload]") {
+  const std::string fffd = "\xEF\xBF\xBD";
+  CHECK(utf8_prefix("bunny.obj", 200) == "bunny.obj");
+  CHECK(utf8_prefix("\xFF.obj", 200) == fffd + ".obj");
+  CHECK(utf8_prefix("caf\xC3\xA9.obj", 200) == "caf\xC3\xA9.obj");           // é kept
+  CHECK(utf8_prefix("caf\xC3.obj", 200) == "caf" + fffd + ".obj");           // a lone lead byte
+  CHECK(utf8_prefix("\xC0\xAF", 200) == fffd + fffd);                        // overlong '/'
+  CHECK(utf8_prefix("\xED\xA0\x80", 200) == fffd + fffd + fffd);             // a surrogate
+  CHECK(utf8_prefix("\xF0\x9F\x98\x80", 200) == "\xF0\x9F\x98\x80");         // an emoji, 4 bytes
+  // 150 x é is 300 bytes: cut at 200 between characters, never inside one.
+  std::string long_name;
+  for (int i = 0; i < 150; ++i) long_name += "\xC3\xA9";
+  const std::string cut = utf8_prefix(long_name, 200);
+  CHECK(cut.size() == 200);
+  CHECK(cut == long_name.substr(0, 200));
+  CHECK(utf8_prefix("ab\xE2\x82\xAC", 4) == "ab");  // the euro sign (3 bytes) does not fit in 2
+  // Whatever the bytes, the result is valid JSON text.
+  std::string all;
+  for (int b = 0; b < 256; ++b) all.push_back(static_cast<char>(b));
+  CHECK_NOTHROW(nlohmann::json(utf8_prefix(all, 1000)).dump());
+}
+
+TEST_CASE("prepare_job keeps a filename that is not UTF-8 as valid UTF-8", "[api][upload]") {
+  const PreparedJob job = prepare_job(sphere_obj(), "\xFF\xFEmesh.obj", Format::Obj, good_params(), {});
+  CHECK(job.record.filename == "\xEF\xBF\xBD\xEF\xBF\xBDmesh.obj");
+  CHECK_NOTHROW(job_to_json(job.record, "/api/v1", 0).dump());
+}

@@ -365,3 +365,31 @@ TEST_CASE("remeshd: the routes in api/openapi.yaml are the routes the server ser
   CHECK(yaml->status == 200);
   CHECK(yaml->body.rfind("openapi: 3", 0) == 0);
 }
+
+TEST_CASE("remeshd: parameters and names that once crashed the service or gave 500", "[server]") {
+  TempDir tmp;
+  Daemon d(tmp.path / "data", {"--workers", "1"});
+  auto c = d.client();
+  // A filename that is not UTF-8, and one of 300 bytes of UTF-8: accepted, kept as valid UTF-8.
+  std::string long_name;
+  for (int i = 0; i < 150; ++i) long_name += "%C3%A9";
+  for (const std::string& name : {std::string("%FF.obj"), long_name + ".obj"}) {
+    auto r = submit_raw(c, sphere_obj(2), "emin=0.08&emax=0.12&iterations=2&filename=" + name);
+    REQUIRE(r);
+    INFO(r->body);
+    CHECK(r->status == 202);
+    const std::string id = body_of(r)["id"];
+    CHECK(wait_final(c, id)["state"] == "succeeded");
+  }
+  // An emin longer than the mesh (its bounding-box diagonal is about 3.5): 422 naming emin, at once.
+  auto r = submit_raw(c, sphere_obj(2), "emin=5&emax=10");
+  REQUIRE(r);
+  CHECK(r->status == 422);
+  CHECK(error_fields(r) == std::set<std::string>{"emin"});
+  // An emax whose square overflows: runs and succeeds (every edge is inside), the service stays up.
+  auto big = submit_raw(c, sphere_obj(2), "emin=0.01&emax=1e300");
+  REQUIRE(big);
+  REQUIRE(big->status == 202);
+  CHECK(wait_final(c, body_of(big)["id"])["state"] == "succeeded");
+  CHECK(c.Get("/healthz")->status == 200);
+}

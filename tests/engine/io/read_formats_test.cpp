@@ -193,3 +193,60 @@ TEST_CASE("glTF and GLB given under each other's name are read by their content"
   CHECK(read_as(write_mesh(soup, Format::Glb), Format::Gltf).format == Format::Glb);
   CHECK(read_as(test::write_gltf_data_uri(soup), Format::Glb).format == Format::Gltf);
 }
+
+TEST_CASE("glTF: JSON nested past the reader's depth is refused, not a stack overflow") {
+  // 20 000 nested arrays in "extras" (40 KB) overflowed tinygltf's recursive parser; 100 are fine.
+  const std::string mesh = test::write_gltf_data_uri(to_soup(test::make_icosphere(0)));
+  REQUIRE(mesh.front() == '{');
+  auto nested = [&](std::size_t depth) {
+    return "{\"extras\":" + std::string(depth, '[') + std::string(depth, ']') + "," + mesh.substr(1);
+  };
+  CHECK(read_as(nested(100)).mesh.n_faces() == 20);
+  for (std::size_t depth : {300, 20000}) {
+    try {
+      read_as(nested(depth));
+      FAIL("nesting of " << depth << " accepted");
+    } catch (const MeshError& e) {
+      CHECK_THAT(e.what(), Catch::Contains("nests arrays and objects more than 256 levels"));
+    }
+  }
+  // Brackets inside strings do not count.
+  CHECK(read_as("{\"extras\":\"" + std::string(1000, '[') + "\"," + mesh.substr(1)).mesh.n_faces() == 20);
+  // The same in a GLB's JSON chunk.
+  std::string json = nested(20000);
+  json.resize((json.size() + 3) / 4 * 4, ' ');
+  std::string glb = "glTF";
+  auto put32 = [&](std::uint32_t v) { glb.append(reinterpret_cast<const char*>(&v), 4); };
+  put32(2);
+  put32(static_cast<std::uint32_t>(20 + json.size()));
+  put32(static_cast<std::uint32_t>(json.size()));
+  glb += "JSON" + json;
+  CHECK_THROWS_WITH(read_as(glb), Catch::Contains("nests arrays and objects"));
+}
+
+TEST_CASE("glTF: a scene that instances its meshes into billions of triangles is refused") {
+  // 3 positions and 3000 byte indices (1000 triangles), under a chain of 16 nodes that each list the
+  // next twice: 65 536 instances, 65 million triangles from a file of a few KB.
+  std::string bin;
+  for (float v : {0.f, 0.f, 0.f, 1.f, 0.f, 0.f, 0.f, 1.f, 0.f}) bin.append(reinterpret_cast<const char*>(&v), 4);
+  for (int i = 0; i < 3000; ++i) bin.push_back(static_cast<char>(i % 3));
+  while (bin.size() % 3) bin.push_back('\0');
+  static const char* t = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  std::string b64;
+  for (std::size_t i = 0; i < bin.size(); i += 3) {
+    unsigned v = (unsigned char)bin[i] << 16 | (unsigned char)bin[i + 1] << 8 | (unsigned char)bin[i + 2];
+    b64 += {t[v >> 18], t[(v >> 12) & 63], t[(v >> 6) & 63], t[v & 63]};
+  }
+  std::string nodes;
+  for (int n = 0; n < 16; ++n)
+    nodes += "{\"children\":[" + std::to_string(n + 1) + "," + std::to_string(n + 1) + "]},";
+  nodes += "{\"mesh\":0}";
+  const std::string gltf = R"({"asset":{"version":"2.0"},"scene":0,"scenes":[{"nodes":[0]}],"nodes":[)" + nodes +
+                           R"(],"meshes":[{"primitives":[{"attributes":{"POSITION":0},"indices":1}]}],
+    "accessors":[{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3"},
+                 {"bufferView":1,"componentType":5121,"count":3000,"type":"SCALAR"}],
+    "bufferViews":[{"buffer":0,"byteLength":36},{"buffer":0,"byteOffset":36,"byteLength":3000}],
+    "buffers":[{"byteLength":)" + std::to_string(bin.size()) +
+                           R"(,"uri":"data:application/octet-stream;base64,)" + b64 + R"("}]})";
+  CHECK_THROWS_WITH(read_as(gltf), Catch::Contains("expands to more than") && Catch::Contains("triangles"));
+}
