@@ -320,6 +320,12 @@ class Cleanup {
       for (auto w : mesh_.vv_range(end))
         if (w != v0 && w != v1) ring.push_back(mesh_.point(w));  // a shared neighbour twice: harmless
     const double reach = 2 * e_max_ * (1 + 1e-9);  // a hair wide, for the rounding of the lengths
+    // First the ring's bounding box: two points in a box are at most its diagonal apart. Most rings
+    // pass here without the pairs, which a vertex of high valence makes quadratic (a 2000-sided
+    // polygon, triangulated as a fan from one corner: 4 million pairs an edge, 4.5 s of its 4.7).
+    Box box;
+    for (const Vec3& p : ring) box.add(p);
+    if (ring.empty() || (box.hi - box.lo).sqrnorm() <= reach * reach) return true;
     for (std::size_t i = 0; i < ring.size(); ++i)
       for (std::size_t j = i + 1; j < ring.size(); ++j)
         if ((ring[i] - ring[j]).sqrnorm() > reach * reach) return false;
