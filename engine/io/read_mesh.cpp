@@ -28,6 +28,14 @@ LoadedMesh read_mesh(std::string_view bytes, const ReadOptions& options) {
     case Format::Glb: soup = io::read_gltf(bytes, true, options); break;
     case Format::Xyz: throw MeshError("unsupported input format xyz (a point list has no faces)");
   }
+  // The OBJ reader passes over lines it does not know: a PLY or OFF file under an .obj name reads
+  // as empty. Say what the content looks like instead of "no vertices and no faces".
+  if (soup.points.empty() && soup.face_count() == 0 && options.format) {
+    const std::optional<Format> sniffed = detect_format(bytes);
+    if (sniffed && sniffed != format)
+      throw MeshError("read as " + std::string(format_name(*format)) + " (its name or format parameter) it holds " +
+                      "no vertices and no faces, but its content looks like " + std::string(format_name(*sniffed)));
+  }
   LoadedMesh out{TriMesh(), *format, std::move(soup.repairs)};
   out.mesh = io::build_mesh(std::move(soup), options, out.repairs);
   return out;

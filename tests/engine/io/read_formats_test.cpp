@@ -250,3 +250,13 @@ TEST_CASE("glTF: a scene that instances its meshes into billions of triangles is
                            R"(,"uri":"data:application/octet-stream;base64,)" + b64 + R"("}]})";
   CHECK_THROWS_WITH(read_as(gltf), Catch::Contains("expands to more than") && Catch::Contains("triangles"));
 }
+
+TEST_CASE("A file given under another format's name says what its content looks like") {
+  const std::string ply = write_mesh(test::make_icosphere(0), Format::Ply);
+  const std::string off = write_mesh(test::make_icosphere(0), Format::Off);
+  CHECK_THROWS_WITH(read_as(ply, Format::Obj), Catch::Contains("read as obj") && Catch::Contains("looks like ply"));
+  CHECK_THROWS_WITH(read_as(off, Format::Obj), Catch::Contains("looks like off"));
+  // Read by its content, it is fine; an empty OBJ is still just empty.
+  CHECK(read_as(ply).mesh.n_faces() == 20);
+  CHECK_THROWS_WITH(read_as("# nothing\n", Format::Obj), Catch::Contains("holds no vertices and no faces"));
+}
