@@ -196,7 +196,11 @@ void HttpServer::Impl::setup() {
     }
     return httplib::Server::HandlerResponse::Unhandled;
   });
-  server.set_post_routing_handler([this](const httplib::Request&, httplib::Response& res) {
+  server.set_post_routing_handler([this](const httplib::Request& req, httplib::Response& res) {
+    // cpp-httplib 0.11 serves the requested byte range of any 200 response but keeps the status a
+    // handler set: a client asking for bytes 0-10 of a job document got "200 OK" and 11 bytes.
+    // A partial answer is a 206 (RFC 9110 15.3.7).
+    if (res.status == 200 && !req.ranges.empty()) res.status = 206;
     cors_headers(res);
     res.set_header("X-Content-Type-Options", "nosniff");
   });

@@ -390,6 +390,17 @@ TEST_CASE("remeshd: parameters and names that once crashed the service or gave 5
   auto big = submit_raw(c, sphere_obj(2), "emin=0.01&emax=1e300");
   REQUIRE(big);
   REQUIRE(big->status == 202);
-  CHECK(wait_final(c, body_of(big)["id"])["state"] == "succeeded");
+  const std::string big_id = body_of(big)["id"];
+  CHECK(wait_final(c, big_id)["state"] == "succeeded");
   CHECK(c.Get("/healthz")->status == 200);
+  // A byte range of a result is a 206 with those bytes (cpp-httplib kept the handler's 200).
+  const std::string url = "/api/v1/jobs/" + big_id + "/result?mesh=remeshed&format=obj";
+  auto whole = c.Get(url.c_str());
+  REQUIRE(whole);
+  REQUIRE(whole->status == 200);
+  REQUIRE(whole->body.size() > 100);
+  auto part = c.Get(url.c_str(), {{"Range", "bytes=0-99"}});
+  REQUIRE(part);
+  CHECK(part->status == 206);
+  CHECK(part->body == whole->body.substr(0, 100));
 }
