@@ -1,6 +1,7 @@
 /// \file read_mesh.cpp
 /// read_mesh / read_mesh_file: choose the format, run its reader, validate and repair.
 
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 
@@ -42,6 +43,11 @@ LoadedMesh read_mesh(std::string_view bytes, const ReadOptions& options) {
 }
 
 LoadedMesh read_mesh_file(const std::string& path, ReadOptions options) {
+  // A device or a pipe may never end (remesh info /dev/zero read forever): regular files only.
+  std::error_code ec;
+  const std::filesystem::file_status status = std::filesystem::status(path, ec);
+  if (!ec && std::filesystem::exists(status) && !std::filesystem::is_regular_file(status))
+    throw MeshError("'" + path + "' is not a regular file");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw MeshError("cannot open '" + path + "'");
   std::ostringstream buffer;

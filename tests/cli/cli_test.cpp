@@ -167,6 +167,10 @@ TEST_CASE("a bad input mesh exits with 3 and one line on stderr", "[cli]") {
       CHECK(lines(r.err) == 1);
     }
   }
+  // A device that never ends is refused at once, not read forever.
+  const ProcessResult r = remesh_cli({"info", "/dev/zero"});
+  CHECK(r.exit_code == 3);
+  CHECK(r.err.find("not a regular file") != std::string::npos);
 }
 
 TEST_CASE("info --json has the counts of a generated mesh", "[cli]") {
