@@ -325,6 +325,7 @@ IterationStats measured_row(const TriMesh& mesh, const Params& params, const Ite
 void check_preconditions(const TriMesh& mesh, const Params& params) {
   if (auto errors = check(params); !errors.empty()) throw ParamsError(std::move(errors));
   if (mesh.n_faces() == 0) throw MeshError("the mesh has no faces");
+  check_mesh_size(mesh);
   if (auto errors = check_against(mesh, params); !errors.empty()) throw ParamsError(std::move(errors));
   const std::size_t estimate = estimate_output_faces(mesh, params);
   if (params.max_output_faces > 0 && estimate > params.max_output_faces)
@@ -404,7 +405,23 @@ double bounding_box_diagonal(const TriMesh& mesh) {
     hi.maximize(mesh.point(v));
     any = true;
   }
-  return any ? (hi - lo).norm() : 0.0;
+  if (!any) return 0.0;
+  // Scaled by the largest extent first, so that a mesh 1e-200 across is not 0 across (the squares
+  // would underflow) nor one 1e200 across infinite.
+  const Vec3 d = hi - lo;
+  const double largest = std::max({std::abs(d[0]), std::abs(d[1]), std::abs(d[2])});
+  return largest > 0 && std::isfinite(largest) ? largest * (d / largest).norm() : largest;
+}
+
+void check_mesh_size(const TriMesh& mesh) {
+  const double diagonal = bounding_box_diagonal(mesh);
+  if (diagonal >= kMinMeshSize && diagonal <= kMaxMeshSize) return;  // false for NaN too
+  char text[200];
+  std::snprintf(text, sizeof text,
+                "the mesh is %.3g across (its bounding-box diagonal): sizes outside %.0e .. %.0e are not supported "
+                "(areas would underflow or overflow); scale it, and the interval with it",
+                diagonal, kMinMeshSize, kMaxMeshSize);
+  throw MeshError(text);
 }
 
 std::vector<FieldError> check_against(const TriMesh& mesh, const Params& params) {

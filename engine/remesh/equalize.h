@@ -119,6 +119,16 @@ double crease_spacing(const Params& params);
 /// Length of the diagonal of the box around the mesh's vertices (0 for an empty mesh).
 double bounding_box_diagonal(const TriMesh& mesh);
 
+/// The sizes of mesh the remesher works at: its bounding-box diagonal within these bounds. Past
+/// them areas and products of lengths underflow or overflow (a tetrahedron 1e100 across was
+/// "too large: 1e18 faces"; 1e-200 across had a diagonal of 0; 1e-100 ended 81 % inside where the
+/// same mesh at any size from 1e-40 to 1e40 ends 100 %).
+inline constexpr double kMinMeshSize = 1e-30, kMaxMeshSize = 1e30;
+
+/// Throws MeshError, saying how large the mesh is, when its bounding-box diagonal lies outside
+/// [kMinMeshSize, kMaxMeshSize] (or is not finite).
+void check_mesh_size(const TriMesh& mesh);
+
 /// What check(params) cannot judge without the mesh: e_min must be shorter than the mesh's
 /// bounding-box diagonal, since no edge between two points of its surface is longer (no edge could
 /// end inside the interval). Every invalid field, named as check() names them; empty when valid.

@@ -495,3 +495,27 @@ TEST_CASE("a tiny e_min does not flood the feature snap with crease points", "[e
   // Every edge is at most e_max (none can be below 1e-9 but a degenerate one, which validity rules out).
   CHECK(test::plain_inside_fraction(mesh, p.e_min, p.e_max) > 0.95);
 }
+
+TEST_CASE("meshes too small or too large for double arithmetic are refused, saying how large", "[equalize]") {
+  for (double scale : {1e-200, 1e-40, 1e40, 1e100}) {
+    INFO("scale " << scale);
+    TriMesh mesh = test::make_icosphere(1, scale);
+    Params p;
+    p.e_min = 0.3 * scale;
+    p.e_max = 0.5 * scale;
+    CHECK_THROWS_AS(check_mesh_size(mesh), MeshError);
+    CHECK_THROWS_WITH(equalize(mesh, p), Catch::Contains("across (its bounding-box diagonal)") &&
+                                             Catch::Contains("not supported"));
+  }
+  // Within the bounds the same mesh remeshes as at size 1.
+  for (double scale : {1e-25, 1.0, 1e25}) {
+    INFO("scale " << scale);
+    TriMesh mesh = test::make_icosphere(3, scale);
+    CHECK_NOTHROW(check_mesh_size(mesh));
+    Params p;
+    p.e_min = 0.2 * scale;
+    p.e_max = 0.3 * scale;
+    equalize(mesh, p);
+    CHECK(test::plain_inside_fraction(mesh, p.e_min, p.e_max) > 0.99);
+  }
+}
