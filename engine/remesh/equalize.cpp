@@ -221,13 +221,15 @@ std::size_t final_patch_budget(const TriMesh& mesh) { return std::max<std::size_
 /// budget; `boundary_only` before the full cleanup starts) or, with `final`, the final cleanup's
 /// (kFinalCleanupRounds, final_patch_budget).
 CleanupCounts run_cleanup(TriMesh& mesh, const ReferenceSurface& reference, const Params& params,
-                          std::vector<NeighbourCache>& caches, bool final, bool boundary_only = false) {
+                          std::vector<NeighbourCache>& caches, bool final, bool boundary_only = false,
+                          std::stop_token stop = {}) {
   CleanupOptions options;
   options.rounds = final ? kFinalCleanupRounds : kCleanupRounds;
   if (final) options.patch_budget = final_patch_budget(mesh);
   options.boundary_only = boundary_only;
   options.caches = &caches;
   options.protect_tips = params.protect_tips;
+  options.stop = std::move(stop);
   return interval_cleanup(mesh, reference, params.e_min, params.e_max, params.flip_factor, options);
 }
 
@@ -578,7 +580,7 @@ Result equalize(TriMesh& mesh, const Params& requested, const OnIteration& on_it
       if (full || reference->has_boundary()) {
         const PhaseTimer timer(phases.cleanup);
         const CleanupCounts c = run_cleanup(mesh, *reference, params, neighbour_caches, /*final=*/false,
-                                            /*boundary_only=*/!full);
+                                            /*boundary_only=*/!full, stop);
         count_cleanup(counters, c);
         renumbered_since += c.splits + c.collapses;
       }
@@ -635,7 +637,8 @@ Result equalize(TriMesh& mesh, const Params& requested, const OnIteration& on_it
         }
         if (!stop.stop_requested()) {
           PhaseTimer timer(phases.cleanup);
-          const CleanupCounts c = run_cleanup(mesh, *reference, params, neighbour_caches, /*final=*/true);
+          const CleanupCounts c =
+              run_cleanup(mesh, *reference, params, neighbour_caches, /*final=*/true, /*boundary_only=*/false, stop);
           timer.stop();
           if (fixes(c) > 0) {
             count_cleanup(row, c);

@@ -19,6 +19,7 @@
 /// inside it does nothing (idempotent).
 
 #include <cstddef>
+#include <stop_token>
 #include <utility>
 #include <vector>
 
@@ -57,6 +58,10 @@ struct CleanupOptions {
   /// Params::protect_tips: tips (is_tip) are never moved (collapses keep them, relocations and
   /// patch relaxations pass them over).
   bool protect_tips = false;
+  /// Checked between rounds and every kStopCheckEvery edges of a round: a request ends the cleanup
+  /// there, the mesh valid (each fix is whole). A round on a pathological input (a polygon of
+  /// thousands of sides) can take seconds, and a cancelled job waited for it.
+  std::stop_token stop;
 };
 
 /// Runs the cleanup. Precondition: no deleted elements (garbage-collected); it leaves the mesh

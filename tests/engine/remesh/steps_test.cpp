@@ -5,6 +5,7 @@
 #include <array>
 #include <cmath>
 #include <random>
+#include <stop_token>
 #include <vector>
 
 #include "remesh/fold_guard.h"
@@ -532,6 +533,18 @@ TEST_CASE("the interval cleanup is safe, keeps vertices on the reference and is 
   };
   const std::size_t before = outside(mesh);
   REQUIRE(before > 0);
+  {
+    // A stop requested before it starts: the cleanup fixes nothing and the mesh stays as it was.
+    std::stop_source stopped;
+    stopped.request_stop();
+    CleanupOptions options;
+    options.stop = stopped.get_token();
+    TriMesh copy = mesh;
+    const CleanupCounts none = interval_cleanup(copy, reference, 1.2, 1.8, 0.5, options);
+    CHECK(none.flips + none.collapses + none.splits + none.relocations + none.patches == 0);
+    CHECK(outside(copy) == before);
+    CHECK(test::check_mesh_valid(copy) == "");
+  }
   const CleanupCounts counts = interval_cleanup(mesh, reference, 1.2, 1.8, 0.5);
   CHECK(counts.outside_before == before);
   CHECK(counts.outside_after == outside(mesh));
