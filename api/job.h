@@ -62,9 +62,10 @@ struct JobRecord {
   std::optional<DualStats> dual;
   std::optional<std::string> error;
   /// Runs started. Counted when a run starts and taken back when the service stops it on shutdown:
-  /// a run the process did not live through (a crash, a kill) stays counted, and a job counted
-  /// kMaxAttempts times is not run again on restart (it fails, named so), so that an input that
-  /// crashes the engine cannot take the service down at every start.
+  /// a run the process did not live through (a crash, a kill) stays counted. A job counted already
+  /// runs alone after a restart (nothing beside it), and one counted kMaxAttempts times is not run
+  /// again (it fails, named so): an input that crashes the engine cannot take the service down at
+  /// every start, and a job that only ran beside it is not blamed.
   int attempts = 0;
 };
 

@@ -30,12 +30,21 @@ namespace {
 // Sends bytes uncompressed. httplib 0.11.4 brotli-compresses every set_content() body at its
 // slowest setting when the client accepts br (browsers always do): seconds for three.js or a big
 // OBJ. A content provider is never compressed.
-void send_bytes(httplib::Response& res, std::string bytes, const std::string& mime) {
+/// A file's bytes as the answer. Streamed from memory in pieces, but when the request asks for byte
+/// ranges, as a body: cpp-httplib 0.11 cuts a body's ranges itself (and answers 416 for those past
+/// its end) before the post-routing handler, while a content provider's ranges it serves as asked,
+/// unclipped ("bytes=0-300000" of a 10 KB file sent 300 001 bytes, most from the heap past the file).
+void send_bytes(const httplib::Request& req, httplib::Response& res, std::string bytes, const std::string& mime) {
+  if (!req.ranges.empty()) {
+    res.set_content(std::move(bytes), mime);
+    return;
+  }
   auto data = std::make_shared<std::string>(std::move(bytes));
   const std::size_t size = data->size();
   res.set_content_provider(size, mime,
                            [data](std::size_t offset, std::size_t length, httplib::DataSink& sink) {
-                             return sink.write(data->data() + offset, length);
+                             if (offset >= data->size()) return false;  // never past the bytes
+                             return sink.write(data->data() + offset, std::min(length, data->size() - offset));
                            });
 }
 
@@ -197,10 +206,12 @@ void HttpServer::Impl::setup() {
     return httplib::Server::HandlerResponse::Unhandled;
   });
   server.set_post_routing_handler([this](const httplib::Request& req, httplib::Response& res) {
-    // cpp-httplib 0.11 serves the requested byte range of any 200 response but keeps the status a
-    // handler set: a client asking for bytes 0-10 of a job document got "200 OK" and 11 bytes.
-    // A partial answer is a 206 (RFC 9110 15.3.7).
-    if (res.status == 200 && !req.ranges.empty()) res.status = 206;
+    // cpp-httplib 0.11 cuts the requested byte ranges out of a body but keeps the status the
+    // handler set: a client asking for bytes 0-10 of a job document got "200 OK" and 11 bytes. A
+    // partial answer is a 206 (RFC 9110 15.3.7).
+    if (res.status == 200 && !req.ranges.empty() &&
+        (res.has_header("Content-Range") || res.get_header_value("Content-Type").starts_with("multipart/byteranges")))
+      res.status = 206;
     cors_headers(res);
     res.set_header("X-Content-Type-Options", "nosniff");
   });
@@ -587,7 +598,7 @@ void HttpServer::Impl::result(const httplib::Request& req, httplib::Response& re
   res.set_header("Content-Disposition", "attachment; filename=\"" + name + "\"");
   auto f = remesh::parse_format(format);
   res.status = 200;
-  send_bytes(res, std::move(bytes), f ? std::string(remesh::mime_type(*f)) : "application/octet-stream");
+  send_bytes(req, res, std::move(bytes), f ? std::string(remesh::mime_type(*f)) : "application/octet-stream");
 }
 
 void HttpServer::Impl::stats(const httplib::Request& req, httplib::Response& res) {
@@ -627,7 +638,7 @@ void HttpServer::Impl::static_files(const httplib::Request& req, httplib::Respon
     return;
   }
   res.set_header("Cache-Control", "no-cache");
-  send_bytes(res, read_file(*file), mime_for(*file));
+  send_bytes(req, res, read_file(*file), mime_for(*file));
 }
 
 HttpServer::HttpServer(const Options& options, JobManager& jobs, Metrics& metrics, Logger& log,

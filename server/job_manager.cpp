@@ -95,6 +95,12 @@ void JobManager::start() {
                   " times while running this job (a crash or a kill); it is not run again";
         r.finished_at = now_seconds();
         persist(r);
+        try {
+          store_.clear_stats(r.id);  // the rows of the run it did not finish
+        } catch (const std::exception& e) {
+          log_.warn("storage", {str("job", r.id), str("error", e.what())});
+        }
+        metrics_.count_job_finished(std::string(state_name(JobState::Failed)));
         log_.warn("job", {str("job", r.id), str("to", "failed"), str("error", *r.error)});
         job->events.push_back({JobEvent::Kind::State, JobState::Queued, 0});
         job->events.push_back({JobEvent::Kind::State, JobState::Failed, 0});
@@ -165,17 +171,37 @@ JobManager::Submit JobManager::submit(const JobRecord& record, std::string_view 
   return Submit::Accepted;
 }
 
+bool JobManager::is_suspect(const std::string& id) const {
+  const auto it = jobs_.find(id);
+  return it != jobs_.end() && it->second->record.state == JobState::Queued && it->second->record.attempts > 0;
+}
+
+bool JobManager::may_start_front() const {
+  if (queue_.empty() || alone_) return false;
+  return !is_suspect(queue_.front()) || active_ == 0;
+}
+
 void JobManager::worker_loop() {
   for (;;) {
     std::string id;
+    bool suspect = false;
     {
       std::unique_lock lock(mutex_);
-      work_.wait(lock, [&] { return stopping_ || !queue_.empty(); });
+      work_.wait(lock, [&] { return stopping_ || may_start_front(); });
       if (stopping_) return;
       id = queue_.front();
       queue_.pop_front();
+      suspect = is_suspect(id);
+      alone_ = suspect;
+      ++active_;
     }
     run(id);
+    {
+      std::lock_guard lock(mutex_);
+      --active_;
+      if (suspect) alone_ = false;
+    }
+    work_.notify_all();  // a suspect may wait for the others to end, the others for a suspect
 #ifdef __GLIBC__
     // The job's memory back to the system, not only to malloc: an idle daemon holds ~20 MB
     // instead of the last job's ~90 (nefertiti, Table 4.2 setup).

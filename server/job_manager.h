@@ -104,6 +104,12 @@ class JobManager {
   };
 
   void worker_loop();
+  /// May a worker take the job at the front of the queue now? A suspect (a job started before
+  /// whose run the process did not live through: JobRecord::attempts >= 1) runs alone, once
+  /// nothing else runs and nothing else starts while it does, so that when the process dies again
+  /// the job that did it is known. Caller holds mutex_.
+  bool may_start_front() const;
+  bool is_suspect(const std::string& id) const;
   void run(const std::string& id);
   void janitor_loop();
   void expire();
@@ -123,6 +129,8 @@ class JobManager {
   std::map<std::string, std::shared_ptr<Job>> jobs_;
   std::deque<std::string> queue_;
   std::size_t busy_ = 0;
+  std::size_t active_ = 0;  ///< jobs taken from the queue by workers and not yet done with
+  bool alone_ = false;      ///< a suspect runs (may_start_front)
   bool stopping_ = false;
   std::vector<std::thread> workers_;
   std::thread janitor_;

@@ -444,7 +444,9 @@ double crease_spacing(const Params& params) {
 }
 
 std::size_t estimate_output_faces(const TriMesh& mesh, const Params& params) {
-  const double m = 0.5 * (params.e_min + params.e_max);
+  // With e_max as the run takes it (at most the bounding-box diagonal, equalize.h): an e_max of
+  // 1e300 made the estimate 0 and so passed any limit.
+  const double m = 0.5 * (params.e_min + std::min(params.e_max, bounding_box_diagonal(mesh)));
   if (!(m > 0) || !std::isfinite(m)) return 0;
   const double faces = surface_area(mesh) / (std::sqrt(3.0) / 4.0 * m * m);
   if (!std::isfinite(faces) || faces > 1e18) return static_cast<std::size_t>(1e18);
@@ -676,6 +678,10 @@ Result equalize(TriMesh& mesh, const Params& requested, const OnIteration& on_it
     // simplification), and the untangling's last round can leave an edge outside.
     if (outcome == Outcome::Stalled || outcome == Outcome::Converged)
       outcome = row.small + row.big == 0 ? Outcome::Converged : Outcome::Stalled;
+    // A stop asked for during the last iteration's ending steps (the final cleanup cut short, the
+    // snap and the untangling skipped) is a cancelled run, not a finished one: the caller must not
+    // take the mesh for a result (the service marked such a job succeeded, the CLI exited 0).
+    if (ending && stop.stop_requested()) outcome = Outcome::Cancelled;
     row.seconds = restore ? best->row.seconds : seconds_since(iteration_start);
     result.iterations_done = row.iteration;
     history.push_back(row);

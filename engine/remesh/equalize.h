@@ -106,7 +106,8 @@ struct Result {
   ThinParts thin;
 };
 
-/// Estimated face count of the output: area / (sqrt(3)/4 * m^2), m = (e_min + e_max) / 2.
+/// Estimated face count of the output: area / (sqrt(3)/4 * m^2), m = (e_min + e_max) / 2, e_max at
+/// most the bounding-box diagonal (as equalize() takes it).
 std::size_t estimate_output_faces(const TriMesh& mesh, const Params& params);
 
 /// The spacing of the feature snap's points along the reference's creases (feature_snap.h): e_min,

@@ -24,7 +24,7 @@ TEST_CASE("job ids are 32 hex characters and distinct", "[api][job]") {
     CHECK_FALSE(is_valid_job_id(bad));
 }
 
-TEST_CASE("state names round trip; final states", "[api][job]") {
+TEST_CASE("state names round trip, final states", "[api][job]") {
   for (JobState s : {JobState::Queued, JobState::Running, JobState::Succeeded, JobState::Failed,
                      JobState::Cancelling, JobState::Cancelled})
     CHECK(parse_state(state_name(s)) == s);

@@ -403,4 +403,23 @@ TEST_CASE("remeshd: parameters and names that once crashed the service or gave 5
   REQUIRE(part);
   CHECK(part->status == 206);
   CHECK(part->body == whole->body.substr(0, 100));
+  // Ranges past the end: never a byte past the file (cpp-httplib served them unclipped from the
+  // heap), a whole answer when the range covers it, 416 when it starts past the end.
+  const std::size_t size = whole->body.size();
+  for (const std::string& url_of : {url, std::string("/")}) {
+    auto full = c.Get(url_of.c_str());
+    REQUIRE(full);
+    auto past = c.Get(url_of.c_str(), {{"Range", "bytes=0-" + std::to_string(10 * full->body.size())}});
+    REQUIRE(past);
+    CHECK(past->status == 206);
+    CHECK(past->body == full->body);
+    auto tail = c.Get(url_of.c_str(), {{"Range", "bytes=" + std::to_string(full->body.size() - 10) + "-"}});
+    REQUIRE(tail);
+    CHECK(tail->body == full->body.substr(full->body.size() - 10));
+    auto beyond = c.Get(url_of.c_str(), {{"Range", "bytes=" + std::to_string(2 * full->body.size()) + "-"}});
+    REQUIRE(beyond);
+    CHECK(beyond->status == 416);
+    CHECK(beyond->body.empty());
+  }
+  CHECK(size > 0);
 }

@@ -31,7 +31,7 @@ std::vector<Case> closed_meshes() {
 
 }  // namespace
 
-TEST_CASE("dual_stats counts the atoms, bonds and rings of the dual; the rings obey Euler's formula", "[dual]") {
+TEST_CASE("dual_stats counts the atoms, bonds and rings of the dual, the rings obey Euler's formula", "[dual]") {
   for (const Case& c : closed_meshes()) {
     INFO(c.name);
     const PolyMesh dual = trivalent_dual(c.mesh);

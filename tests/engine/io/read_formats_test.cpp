@@ -60,7 +60,7 @@ TEST_CASE("OBJ: a concave polygon is ear-clipped, not fanned across the outside"
   for (auto f : m.mesh.faces()) CHECK(m.mesh.normal(f)[2] > 0.99);
 }
 
-TEST_CASE("OFF: ASCII with comments, colours and counts on the header line; binary OFF") {
+TEST_CASE("OFF: ASCII with comments, colours and counts on the header line, binary OFF") {
   const std::string off =
       "COFF 4 4 6 # tetrahedron\n"
       "# vertices\n"

@@ -84,7 +84,7 @@ TEST_CASE("Exact positions survive text formats, including awkward doubles") {
   }
 }
 
-TEST_CASE("Polygon soups keep their polygons in OBJ, OFF and PLY; GLB adds a LINES primitive") {
+TEST_CASE("Polygon soups keep their polygons in OBJ, OFF and PLY, GLB adds a LINES primitive") {
   // A cube of quads plus a hexagonal cap elsewhere.
   PolygonSoup soup = test::make_soup(
       {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, {0, 0, 1}, {1, 0, 1}, {1, 1, 1}, {0, 1, 1}},
@@ -132,7 +132,7 @@ TEST_CASE("XYZ writes one carbon atom per point") {
   CHECK(exact);
 }
 
-TEST_CASE("Files: the extension chooses the format; unknown extensions are refused") {
+TEST_CASE("Files: the extension chooses the format, unknown extensions are refused") {
   const auto dir = std::filesystem::temp_directory_path() / ("remesh_io_test_" + std::to_string(::getpid()));
   std::filesystem::create_directories(dir);
   PolygonSoup soup = to_soup(test::make_torus(8, 6, 2, 0.7));

@@ -462,6 +462,14 @@ TEST_CASE("intervals far beyond the mesh's size are refused or taken as its size
       CHECK(errors[0].field == "emin");
       CHECK_THROWS_AS(equalize(mesh, p), ParamsError);
     }
+    // The output estimate takes e_max as the run does: a huge e_max does not make it 0.
+    Params tiny_min;
+    tiny_min.e_min = 1e-3;
+    tiny_min.e_max = 1e300;
+    Params at_diagonal = tiny_min;
+    at_diagonal.e_max = diagonal;
+    CHECK(estimate_output_faces(input, tiny_min) == estimate_output_faces(input, at_diagonal));
+    CHECK(estimate_output_faces(input, tiny_min) > 0);
     Params ok;
     ok.e_min = 0.5 * diagonal;
     ok.e_max = diagonal;
