@@ -168,7 +168,9 @@ void drop_bad_faces(TriSoup& soup, const RawSoup& raw, std::vector<Repair>& repa
   soup.source.resize(out);
   if (degenerate_count > 0)
     repairs.push_back({"degenerate_faces_removed", degenerate_count,
-                       std::to_string(degenerate_count) + " zero-area faces dropped (first: " + first_degenerate + ")"});
+                       std::to_string(degenerate_count) + " zero-area faces dropped (first: " + first_degenerate +
+                           "); where such a face closed the surface a hole is left, and the remeshed surface "
+                           "keeps it (--weld / weld=true merges coincident vertices first)"});
   if (duplicate_count > 0)
     repairs.push_back({"duplicate_faces_removed", duplicate_count,
                        std::to_string(duplicate_count) + " duplicate faces dropped (first: " + first_duplicate + ")"});

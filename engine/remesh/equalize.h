@@ -122,8 +122,8 @@ double bounding_box_diagonal(const TriMesh& mesh);
 
 /// The sizes of mesh the remesher works at: its bounding-box diagonal within these bounds. Past
 /// them areas and products of lengths underflow or overflow (a tetrahedron 1e100 across was
-/// "too large: 1e18 faces"; 1e-200 across had a diagonal of 0; 1e-100 ended 81 % inside where the
-/// same mesh at any size from 1e-40 to 1e40 ends 100 %).
+/// "too large: 1e18 faces"; 1e-200 across had a diagonal of 0; a tetrahedron 1e-100 across ended
+/// 81 % inside where at size 1 it ends 100 %; spot gives the same figures from 1e-28 to 1e28 across).
 inline constexpr double kMinMeshSize = 1e-30, kMaxMeshSize = 1e30;
 
 /// Throws MeshError, saying how large the mesh is, when its bounding-box diagonal lies outside

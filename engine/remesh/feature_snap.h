@@ -10,7 +10,9 @@
 /// more than 20 degrees, a mesh edge that crosses the crease between vertices on either face cuts
 /// under it (eight.off, a coarse input whose waist creases meet at 38 degrees: 0.26 units, the
 /// largest distance of the run). So the points are the interior reference vertices and, when the
-/// run gives a spacing (equalize: e_min), points along every such crease at most that far apart.
+/// run gives a spacing (equalize: crease_spacing(), e_min but at least a quarter of (e_min +
+/// e_max) / 2, which is more than e_min only when e_max > 7 e_min), points along every such crease
+/// at most that far apart.
 ///
 /// In the last iteration of a run (converged, stalled or n reached), up to kSnapPasses passes:
 /// every such point farther from the mesh than a tenth of e_min and at least

@@ -144,12 +144,12 @@ TEST_CASE("utf8_prefix: filenames become valid UTF-8, cut between characters", "
   CHECK(utf8_prefix("\xC0\xAF", 200) == fffd + fffd);                        // overlong '/'
   CHECK(utf8_prefix("\xED\xA0\x80", 200) == fffd + fffd + fffd);             // a surrogate
   CHECK(utf8_prefix("\xF0\x9F\x98\x80", 200) == "\xF0\x9F\x98\x80");         // an emoji, 4 bytes
-  // 150 x é is 300 bytes: cut at 200 between characters, never inside one.
-  std::string long_name;
+  // "a" and 150 x é is 301 bytes: byte 200 falls inside an é, so the cut is at 199, before it.
+  std::string long_name = "a";
   for (int i = 0; i < 150; ++i) long_name += "\xC3\xA9";
   const std::string cut = utf8_prefix(long_name, 200);
-  CHECK(cut.size() == 200);
-  CHECK(cut == long_name.substr(0, 200));
+  CHECK(cut.size() == 199);
+  CHECK(cut == long_name.substr(0, 199));
   CHECK(utf8_prefix("ab\xE2\x82\xAC", 4) == "ab");  // the euro sign (3 bytes) does not fit in 2
   // Whatever the bytes, the result is valid JSON text.
   std::string all;

@@ -371,7 +371,7 @@ TEST_CASE("remeshd: parameters and names that once crashed the service or gave 5
   Daemon d(tmp.path / "data", {"--workers", "1"});
   auto c = d.client();
   // A filename that is not UTF-8, and one of 300 bytes of UTF-8: accepted, kept as valid UTF-8.
-  std::string long_name;
+  std::string long_name = "a";  // 301 bytes: byte 200 falls inside an é
   for (int i = 0; i < 150; ++i) long_name += "%C3%A9";
   for (const std::string& name : {std::string("%FF.obj"), long_name + ".obj"}) {
     auto r = submit_raw(c, sphere_obj(2), "emin=0.08&emax=0.12&iterations=2&filename=" + name);
