@@ -27,13 +27,13 @@ using remesh::api::make_problem;
 
 namespace {
 
-// Sends bytes uncompressed. httplib 0.11.4 brotli-compresses every set_content() body at its
-// slowest setting when the client accepts br (browsers always do): seconds for three.js or a big
-// OBJ. A content provider is never compressed.
-/// A file's bytes as the answer. Streamed from memory in pieces, but when the request asks for byte
-/// ranges, as a body: cpp-httplib 0.11 cuts a body's ranges itself (and answers 416 for those past
-/// its end) before the post-routing handler, while a content provider's ranges it serves as asked,
-/// unclipped ("bytes=0-300000" of a 10 KB file sent 300 001 bytes, most from the heap past the file).
+/// A file's bytes as the answer, from a content provider: httplib 0.11.4 brotli-compresses every
+/// set_content() body at its slowest setting when the client accepts br (browsers always do):
+/// seconds for three.js or a big OBJ; a content provider is never compressed. But a request for
+/// byte ranges gets them as a body: httplib cuts a body's ranges itself (416 past its end) before
+/// the post-routing handler, while a provider's ranges it serves as asked, unclipped ("bytes=0-300000"
+/// of a 10 KB file sent 300 001 bytes, most from the heap past the file). Such a range of a text
+/// file may then be compressed (the range of the uncompressed bytes, br-encoded).
 void send_bytes(const httplib::Request& req, httplib::Response& res, std::string bytes, const std::string& mime) {
   if (!req.ranges.empty()) {
     res.set_content(std::move(bytes), mime);

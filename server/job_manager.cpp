@@ -87,37 +87,33 @@ void JobManager::start() {
         for (std::size_t i = 0; i < job->rows.size(); ++i)
           job->events.push_back({JobEvent::Kind::Iteration, r.state, i});
         job->events.push_back({JobEvent::Kind::State, r.state, 0});
-      } else if (r.attempts >= remesh::api::kMaxAttempts) {
-        // The process ended during each of its runs, and not by a shutdown: the input may crash
-        // the engine. Failed, not run again (JobRecord::attempts).
-        r.state = JobState::Failed;
-        r.error = "the service stopped " + std::to_string(r.attempts) +
-                  " times while running this job (a crash or a kill); it is not run again";
-        r.finished_at = now_seconds();
-        persist(r);
-        try {
-          store_.clear_stats(r.id);  // the rows of the run it did not finish
-        } catch (const std::exception& e) {
-          log_.warn("storage", {str("job", r.id), str("error", e.what())});
-        }
-        metrics_.count_job_finished(std::string(state_name(JobState::Failed)));
-        log_.warn("job", {str("job", r.id), str("to", "failed"), str("error", *r.error)});
-        job->events.push_back({JobEvent::Kind::State, JobState::Queued, 0});
-        job->events.push_back({JobEvent::Kind::State, JobState::Failed, 0});
-      } else {  // accepted but not finished: run it (again) from the start
-        r.state = JobState::Queued;
-        r.started_at.reset();
-        r.iteration = 0;
-        r.latest.reset();
+      } else {
+        // Accepted but not finished: the rows of the run it did not finish go either way.
         try {
           store_.clear_stats(r.id);
         } catch (const std::exception& e) {
           log_.warn("storage", {str("job", r.id), str("error", e.what())});
         }
-        persist(r);
+        r.iteration = 0;
+        r.latest.reset();
         job->events.push_back({JobEvent::Kind::State, JobState::Queued, 0});
-        queue_.push_back(r.id);
-        ++requeued;
+        if (r.attempts >= remesh::api::kMaxAttempts) {
+          // The process ended during each of its runs, and not by a shutdown: the input may crash
+          // the engine. Failed, not run again (JobRecord::attempts).
+          r.state = JobState::Failed;
+          r.error = "the service stopped " + std::to_string(r.attempts) +
+                    " times while running this job (a crash or a kill); it is not run again";
+          r.finished_at = now_seconds();
+          metrics_.count_job_finished(std::string(state_name(JobState::Failed)));
+          log_.warn("job", {str("job", r.id), str("to", "failed"), str("error", *r.error)});
+          job->events.push_back({JobEvent::Kind::State, JobState::Failed, 0});
+        } else {  // run it (again) from the start
+          r.state = JobState::Queued;
+          r.started_at.reset();
+          queue_.push_back(r.id);
+          ++requeued;
+        }
+        persist(r);
       }
       jobs_[r.id] = job;
     }

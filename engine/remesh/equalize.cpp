@@ -6,7 +6,6 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
-#include <limits>
 #include <memory>
 #include <optional>
 #include <string>
@@ -15,6 +14,7 @@
 #include "core/errors.h"
 #include "remesh/feature_snap.h"
 #include "remesh/fold_guard.h"
+#include "remesh/geometry.h"
 #include "remesh/interval_cleanup.h"
 #include "remesh/low_pass_filter.h"
 #include "remesh/mesh_snapshot.h"
@@ -96,9 +96,6 @@ double main_phase_sigma(const Params& params) {
 /// Scaling sigma by m_i / m instead changed the runs from 2x to 5x as well, with no better
 /// outcome (regular vertices 6-9 points lower on spot, bunny and kitten at k=6).
 constexpr double kMaxBandShare = 0.5;
-
-/// See crease_spacing() (equalize.h).
-constexpr double kMinCreaseSpacing = 0.25;
 double band_at(double sigma, double m_i) { return std::min(sigma, kMaxBandShare * m_i); }
 
 /// Flip sweeps per iteration: the thesis does one; further sweeps catch the flips the first one
@@ -400,17 +397,12 @@ const char* outcome_name(Outcome o) {
 }
 
 double bounding_box_diagonal(const TriMesh& mesh) {
-  Vec3 lo(std::numeric_limits<double>::max()), hi(std::numeric_limits<double>::lowest());
-  bool any = false;
-  for (auto v : mesh.vertices()) {
-    lo.minimize(mesh.point(v));
-    hi.maximize(mesh.point(v));
-    any = true;
-  }
-  if (!any) return 0.0;
+  Box box;
+  for (auto v : mesh.vertices()) box.add(mesh.point(v));
+  if (!(box.lo[0] <= box.hi[0])) return 0.0;  // no vertex
   // Scaled by the largest extent first, so that a mesh 1e-200 across is not 0 across (the squares
   // would underflow) nor one 1e200 across infinite.
-  const Vec3 d = hi - lo;
+  const Vec3 d = box.hi - box.lo;
   const double largest = std::max({std::abs(d[0]), std::abs(d[1]), std::abs(d[2])});
   return largest > 0 && std::isfinite(largest) ? largest * (d / largest).norm() : largest;
 }
@@ -439,14 +431,23 @@ std::vector<FieldError> check_against(const TriMesh& mesh, const Params& params)
   return errors;
 }
 
+Params as_run(const TriMesh& mesh, const Params& params) {
+  Params run = params;
+  run.e_max = std::min(params.e_max, bounding_box_diagonal(mesh));
+  return run;
+}
+
+/// See crease_spacing() (equalize.h).
+constexpr double kMinCreaseSpacing = 0.25;
+
 double crease_spacing(const Params& params) {
   return std::max(params.e_min, kMinCreaseSpacing * 0.5 * (params.e_min + params.e_max));
 }
 
 std::size_t estimate_output_faces(const TriMesh& mesh, const Params& params) {
-  // With e_max as the run takes it (at most the bounding-box diagonal, equalize.h): an e_max of
-  // 1e300 made the estimate 0 and so passed any limit.
-  const double m = 0.5 * (params.e_min + std::min(params.e_max, bounding_box_diagonal(mesh)));
+  // With e_max as the run takes it (as_run): an e_max of 1e300 made the estimate 0, under any limit.
+  const Params run = as_run(mesh, params);
+  const double m = 0.5 * (run.e_min + run.e_max);
   if (!(m > 0) || !std::isfinite(m)) return 0;
   const double faces = surface_area(mesh) / (std::sqrt(3.0) / 4.0 * m * m);
   if (!std::isfinite(faces) || faces > 1e18) return static_cast<std::size_t>(1e18);
@@ -455,9 +456,7 @@ std::size_t estimate_output_faces(const TriMesh& mesh, const Params& params) {
 
 Result equalize(TriMesh& mesh, const Params& requested, const OnIteration& on_iteration, std::stop_token stop) {
   check_preconditions(mesh, requested);
-  // e_max at most the bounding-box diagonal (equalize.h): the same edges are inside either way.
-  Params params = requested;
-  params.e_max = std::min(params.e_max, bounding_box_diagonal(mesh));
+  const Params params = as_run(mesh, requested);
   const auto start = Clock::now();
   const unsigned threads = params.threads;
   const double m = 0.5 * (params.e_min + params.e_max);

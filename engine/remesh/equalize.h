@@ -117,6 +117,11 @@ std::size_t estimate_output_faces(const TriMesh& mesh, const Params& params);
 /// near 0.5.
 double crease_spacing(const Params& params);
 
+/// The parameters a run uses: e_max at most the mesh's bounding-box diagonal. No edge on the
+/// surface is longer, so the same edges are inside, and the steps that aim at (e_min + e_max) / 2
+/// aim at a length the surface has (an e_max of 1e300 made eq. 3.1 overflow to NaN positions).
+Params as_run(const TriMesh& mesh, const Params& params);
+
 /// Length of the diagonal of the box around the mesh's vertices (0 for an empty mesh).
 double bounding_box_diagonal(const TriMesh& mesh);
 
@@ -137,10 +142,8 @@ std::vector<FieldError> check_against(const TriMesh& mesh, const Params& params)
 
 /// Remeshes `mesh` in place. Preconditions: a valid 2-manifold, consistently oriented TriMesh (as
 /// read_mesh returns). Throws ParamsError if check(params) or check_against(mesh, params) fails,
-/// LimitError if the estimated output exceeds params.max_output_faces. An e_max beyond the mesh's
-/// bounding-box diagonal is taken as the diagonal: no edge on the surface is longer, so the same
-/// edges are inside, and the steps that aim at (e_min + e_max) / 2 aim at a length the surface has
-/// (an e_max of 1e300 made eq. 3.1 overflow to NaN positions). `on_iteration` runs on the calling thread after each iteration.
+/// LimitError if the estimated output exceeds params.max_output_faces. Runs with as_run(mesh,
+/// params). `on_iteration` runs on the calling thread after each iteration.
 /// A stop request is honoured between phases; the mesh is valid whenever this returns.
 Result equalize(TriMesh& mesh, const Params& params, const OnIteration& on_iteration = {},
                 std::stop_token stop = {});
