@@ -61,19 +61,22 @@ bool below_min_angle(const Vec3& a, const Vec3& b, const Vec3& c);
 /// kMinAngle only if no worse than the worst triangle it replaces, whose angle `worst()` returns.
 /// worst() runs at most once, and only for a new triangle below kMinAngle: the arc tangents of the
 /// old triangles are nearly never needed.
+/// With a `slack`, "no worse" allows a relative loss of that much (split_point_ok's kSplitAngleSlack).
 template <class Worst>
 class AngleFloor {
  public:
-  explicit AngleFloor(Worst worst) : worst_(std::move(worst)) {}
-  /// Would triangle (a, b, c) break the rule? Equal to min_angle(a, b, c) < min(kMinAngle, worst()).
+  explicit AngleFloor(Worst worst, double slack = 0) : worst_(std::move(worst)), keep_(1 - slack) {}
+  /// Would triangle (a, b, c) break the rule? Equal to
+  /// min_angle(a, b, c) < min(kMinAngle, (1 - slack) worst()).
   bool breaks(const Vec3& a, const Vec3& b, const Vec3& c) {
     if (!below_min_angle(a, b, c)) return false;
-    if (!known_) worst_angle_ = worst_(), known_ = true;
+    if (!known_) worst_angle_ = worst_() * keep_, known_ = true;
     return min_angle(a, b, c) < worst_angle_;
   }
 
  private:
   Worst worst_;
+  double keep_;
   bool known_ = false;
   double worst_angle_ = 0;
 };

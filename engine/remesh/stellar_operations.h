@@ -3,7 +3,8 @@
 /// Algorithm 3: walk the priority list; split long edges, collapse short ones, with visited marking,
 /// eq. 3.1 repositioning and the safety checks that keep the mesh a valid 2-manifold of unchanged
 /// topology with no folded or degenerate triangle:
-/// - a split puts its vertex on the edge (eq. 3.1) and refuses to create a degenerate triangle;
+/// - a split puts its vertex on the edge (eq. 3.1) and refuses to create a degenerate triangle (one
+///   below geom::kMinAngle, unless no worse than the one it replaces, within kSplitAngleSlack);
 /// - a collapse must pass OpenMesh's is_collapse_ok (link condition), must not fold a triangle,
 ///   create a degenerate one or an edge longer than collapse_length_limit(); it never collapses an interior
 ///   edge whose two ends lie on the boundary (that would pinch or join two boundary loops), keeps a

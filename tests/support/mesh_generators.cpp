@@ -92,6 +92,19 @@ TriMesh make_open_grid(int nx, int ny, double spacing) {
   return m;
 }
 
+TriMesh make_fan(int sectors, double radius) {
+  TriMesh m;
+  const VH centre = m.add_vertex(Vec3(0, 0, 0));
+  std::vector<VH> rim;
+  for (int i = 0; i < sectors; ++i) {
+    const double a = 2 * M_PI * i / sectors;
+    rim.push_back(m.add_vertex(Vec3(radius * std::cos(a), radius * std::sin(a), 0)));
+  }
+  for (int i = 0; i < sectors; ++i) add_tri(m, centre, rim[i], rim[(i + 1) % sectors]);
+  m.update_normals();
+  return m;
+}
+
 TriMesh make_hex_lattice_patch(int rows, int cols, double spacing) {
   TriMesh m;
   std::vector<VH> vh;

@@ -24,6 +24,9 @@ TriMesh make_hex_lattice_patch(int rows, int cols, double spacing);
 TriMesh make_plate_with_holes(int holes, double cell = 1.0, int sub = 2);
 /// Genus-2 closed surface (make_plate_with_holes(2, ...)).
 TriMesh make_double_torus(double cell = 1.0, int sub = 2);
+/// Flat disk of `radius` in z = 0 triangulated as a fan: `sectors` triangles around a centre vertex
+/// (a cap as CAD exports write it; above 360 sectors every triangle has an angle below 1 degree).
+TriMesh make_fan(int sectors, double radius);
 
 /// Empty if `mesh` is valid: no deleted elements left, every vertex manifold, every face a
 /// non-degenerate triangle (area > area_eps * mean area), no folded pair of adjacent triangles

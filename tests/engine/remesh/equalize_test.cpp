@@ -283,6 +283,24 @@ TEST_CASE("a target ten times the input's mean edge is reached", "[equalize]") {
   }
 }
 
+TEST_CASE("a flat fan of 600 sectors around one vertex is remeshed", "[equalize]") {
+  // A disk cut into 600 slivers (angles of 0.6 degrees) around its centre, the target half its
+  // radius. A rim collapse would keep a spoke longer than the collapse length limit, so the spokes
+  // must split first, which makes triangles a hair thinner than the slivers (kSplitAngleSlack).
+  // Without that slack three of these four intervals returned the fan unchanged, 0 % inside.
+  for (const auto& [lo, hi] : {std::pair{0.405, 0.607}, std::pair{0.38, 0.57}, std::pair{0.42, 0.63},
+                               std::pair{0.45, 0.675}}) {
+    TriMesh mesh = test::make_fan(600, 1.0);
+    Params p;
+    p.e_min = lo;
+    p.e_max = hi;
+    INFO("interval [" << lo << ", " << hi << "]");
+    remesh_and_check(mesh, p);
+    CHECK(test::plain_inside_fraction(mesh, lo, hi) >= 0.99);
+    CHECK(mesh.n_vertices() < 100);  // about 2 pi / (sqrt(3) / 2 * 0.5^2) = 29 around the target
+  }
+}
+
 TEST_CASE("the returned mesh's normals are those of its faces", "[equalize]") {
   // A converged run (the mesh of the last iteration) and a stalled one (the mesh of its low, rebuilt
   // from a snapshot), refined and simplified.

@@ -85,6 +85,10 @@ TEST_CASE("AngleFloor applies the edits' degeneracy rule and asks for the old wo
     CHECK(calls == (geom::min_angle(a, b, c) < geom::kMinAngle ? 1 : 0));
     floor.breaks(a, b, c);
     CHECK(calls <= 1);
+    // With a slack, "no worse" allows that relative loss.
+    const double slack = 0.25;
+    geom::AngleFloor loose([&] { return worst; }, slack);
+    CHECK(loose.breaks(a, b, c) == (geom::min_angle(a, b, c) < std::min(geom::kMinAngle, (1 - slack) * worst)));
   }
 }
 

@@ -152,6 +152,25 @@ TEST_CASE("boundary collapses stay on the boundary and never pinch", "[steps]") 
     if (mesh.is_boundary(v)) CHECK(std::abs(mesh.point(v)[2]) < 1e-12);
 }
 
+TEST_CASE("a split of a sliver's long side is kept when it loses no more than a hair of its angle", "[steps]") {
+  // A disk of 600 sectors (angles of 0.6 degrees at the centre): splitting a spoke at its middle
+  // keeps 0.6 degrees at the centre and leaves 0.6 * (1 - 1e-4) at the rim. Refused while a split
+  // could make nothing smaller than the sliver it replaces: such a fan stalled unchanged.
+  const double theta = 2 * M_PI / 600;
+  TriMesh fan = test::make_fan(600, 1.0);
+  std::vector<EdgeHandle> spokes;
+  for (auto e : fan.edges())
+    if (!fan.is_boundary(e) && spokes.size() < 40) spokes.push_back(e);
+  std::size_t splits = 0;
+  for (std::size_t k = 0; k < spokes.size(); k += 2)
+    if (split_edge(fan, spokes[k], 0.5).is_valid()) ++splits;
+  CHECK(splits == spokes.size() / 2);
+  for (auto e : fan.edges())
+    if (!fan.is_boundary(e)) CHECK(two_face_min_angle(fan, e) >= theta * (1 - 1e-3));
+  CHECK(test::check_mesh_valid(fan) == "");
+  CHECK(test::euler_characteristic(fan) == 1);
+}
+
 TEST_CASE("a collapse beside a tip keeps the tip where it is", "[steps]") {
   // An icosphere with one vertex pulled out to 1.6 times the radius: a spike whose apex has an angle
   // deficit of about 4 radians (is_tip), its neighbours not tips. Each edge from the
