@@ -2,11 +2,13 @@
 
 #include <httplib.h>
 
+#include <algorithm>
 #include <atomic>
 #include <charconv>
 #include <cmath>
 #include <chrono>
 #include <regex>
+#include <utility>
 
 #include "api/json_codec.h"
 #include "api/problem.h"
@@ -309,7 +311,8 @@ void HttpServer::Impl::post_job(const httplib::Request& req, httplib::Response& 
                                 const httplib::ContentReader& reader) {
   const std::size_t limit = options.max_upload_mb * kMiB;
   std::string body, params_text, filename, part_type, part;
-  bool got_mesh = false, got_params = false, too_big = false, params_too_big = false;
+  bool too_big = false, params_too_big = false;
+  int mesh_parts = 0, params_parts = 0;  // a second part of either is refused, not joined to the first
   std::size_t total = 0;
   auto count = [&](std::size_t n) {
     total += n;
@@ -324,20 +327,20 @@ void HttpServer::Impl::post_job(const httplib::Request& req, httplib::Response& 
     ok = reader(
         [&](const httplib::MultipartFormData& header) {
           part = header.name;
-          if (part == "mesh") {
-            got_mesh = true;
+          if (part == "mesh" && ++mesh_parts == 1) {
             filename = header.filename;
             part_type = header.content_type;
           } else if (part == "params") {
-            got_params = true;
+            ++params_parts;
           }
           return true;
         },
         [&](const char* data, std::size_t n) {
           if (!count(n)) return false;
           if (too_big) return true;
-          if (part == "mesh") body.append(data, n);
-          else if (part == "params") {
+          if (part == "mesh") {
+            if (mesh_parts == 1) body.append(data, n);
+          } else if (part == "params" && params_parts == 1) {
             if (params_text.size() + n > kMaxParamsBytes) params_too_big = true;
             else params_text.append(data, n);
           }
@@ -370,7 +373,10 @@ void HttpServer::Impl::post_job(const httplib::Request& req, httplib::Response& 
 
   std::vector<FieldError> errors;
   remesh::ParsedParams parsed;
-  if (got_params) {
+  for (const auto& [name, parts] : {std::pair{"mesh", mesh_parts}, std::pair{"params", params_parts}})
+    if (parts > 1)
+      errors.push_back({name, "was sent " + std::to_string(parts) + " times; a job takes one (one remesh job per request)"});
+  if (params_parts > 0) {
     json j = json::parse(params_text, nullptr, false);
     if (params_too_big) errors.push_back({"params", "is larger than 64 KiB"});
     else if (j.is_discarded()) errors.push_back({"params", "is not valid JSON"});
@@ -378,10 +384,10 @@ void HttpServer::Impl::post_job(const httplib::Request& req, httplib::Response& 
   } else {
     parsed = remesh::params_from_query(query_params(req), {"format", "filename", "access_token"});
   }
-  if (req.is_multipart_form_data() && !got_mesh) errors.push_back({"mesh", "is required (a file field named 'mesh')"});
+  if (req.is_multipart_form_data() && mesh_parts == 0) errors.push_back({"mesh", "is required (a file field named 'mesh')"});
   else if (body.empty()) errors.push_back({"mesh", "is empty"});
   auto format = remesh::api::resolve_format(req.get_param_value("format"), filename, part_type, errors);
-  bool params_readable = errors.empty() || errors.front().field != "params";
+  bool params_readable = std::none_of(errors.begin(), errors.end(), [](const FieldError& e) { return e.field == "params"; });
   if (params_readable)
     for (const FieldError& e : remesh::validate_params(parsed, options.max_iterations)) errors.push_back(e);
   if (!errors.empty()) {

@@ -252,6 +252,20 @@ TEST_CASE("remeshd: the errors each route must give", "[server]") {
   REQUIRE(bj);
   CHECK(bj->status == 422);
   CHECK(error_fields(bj) == std::set<std::string>{"params"});
+  // Two mesh parts (and two params parts) are refused, not joined into one mesh.
+  httplib::MultipartFormDataItems two_meshes = {
+      {"mesh", mesh, "a.obj", ""}, {"mesh", mesh, "b.obj", ""}, {"params", R"({"emin":1,"emax":2})", "", ""}};
+  auto tm = c.Post("/api/v1/jobs", two_meshes);
+  REQUIRE(tm);
+  CHECK(tm->status == 422);
+  CHECK(error_fields(tm) == std::set<std::string>{"mesh"});
+  httplib::MultipartFormDataItems two_params = {{"mesh", mesh, "a.obj", ""},
+                                                {"params", R"({"emin":1,"emax":2})", "", ""},
+                                                {"params", R"({"emin":1,"emax":2})", "", ""}};
+  auto tp = c.Post("/api/v1/jobs", two_params);
+  REQUIRE(tp);
+  CHECK(tp->status == 422);
+  CHECK(error_fields(tp) == std::set<std::string>{"params"});
   // cpp-httplib 0.11.4 refuses parameters after the boundary; the answer says so.
   auto charset = c.Post("/api/v1/jobs",
                         "--XX\r\nContent-Disposition: form-data; name=\"mesh\"; filename=\"a.obj\"\r\n\r\n" +
