@@ -56,6 +56,8 @@ constexpr std::size_t kMaxParamsBytes = 64 * 1024;
 /// How much of an over-limit upload is read (and dropped) so the client can read the 413; beyond
 /// it the connection is closed.
 constexpr std::size_t kDrainBytes = 64 * kMiB;
+/// How often an idle event stream checks that its client is still there.
+constexpr double kLeftCheckSeconds = 1.0;
 
 thread_local std::chrono::steady_clock::time_point t_request_start;
 
@@ -519,8 +521,19 @@ void HttpServer::Impl::events(const httplib::Request& req, httplib::Response& re
           out += sse_retry(3000);
           if (stream->state_before) out += sse_state(*stream->state_before);
         }
-        double left = std::chrono::duration<double>(stream->deadline - std::chrono::steady_clock::now()).count();
-        JobManager::Batch batch = jobs.poll(stream->id, stream->cursor, std::max(0.0, std::min(heartbeat, left)));
+        // Wait for events up to the heartbeat (or the stream's end), in slices of kLeftCheckSeconds
+        // between which a client that left is noticed: its stream slot (--max-streams) and HTTP
+        // thread were held until the next heartbeat's write failed.
+        const auto now = std::chrono::steady_clock::now();
+        const auto until = std::min(stream->deadline, now + std::chrono::milliseconds(static_cast<long long>(heartbeat * 1000)));
+        JobManager::Batch batch;
+        for (;;) {
+          const double left = std::chrono::duration<double>(until - std::chrono::steady_clock::now()).count();
+          batch = jobs.poll(stream->id, stream->cursor, std::max(0.0, std::min(kLeftCheckSeconds, left)));
+          if (!batch.found || !batch.events.empty() || batch.ended || batch.shutting_down || left <= kLeftCheckSeconds)
+            break;
+          if (!sink.is_writable()) return false;
+        }
         if (!batch.found) {  // removed while streaming
           out += sse_comment("job removed");
           sink.write(out.data(), out.size());

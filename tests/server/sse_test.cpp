@@ -160,3 +160,30 @@ TEST_CASE("remeshd: many streams on 2 workers, /healthz keeps answering", "[serv
   }
   for (const std::string& id : ids) CHECK(get_job(c, id)["state"] == "succeeded");
 }
+
+TEST_CASE("remeshd SSE: a client that leaves frees its stream slot before the next heartbeat", "[server][sse]") {
+  // Heartbeats a minute apart: the slot of a client that hung up was held until the next one's
+  // write failed, and with --max-streams 1 every other client got 503 meanwhile.
+  TempDir tmp;
+  Daemon d(tmp.path / "data", {"--workers", "1", "--max-streams", "1", "--heartbeat-seconds", "60"});
+  auto c = d.client();
+  const std::string slow = submit(c, sphere_obj(4), "emin=0.02&emax=0.035&iterations=400&run_all_iterations=true");
+  const std::string waiting = submit(c, sphere_obj(2), "emin=0.2&emax=0.35&iterations=2");
+  const std::string path = "/api/v1/jobs/" + waiting + "/events";
+  auto open_streams = [&] { return json::parse(c.Get("/healthz")->body)["event_streams"].get<int>(); };
+  {
+    // Reads the first chunk (the retry hint and the queued state), then hangs up.
+    httplib::Client leaving("127.0.0.1", d.port());
+    bool got = false;
+    auto r = leaving.Get(path.c_str(), [&](const char*, size_t) { return !(got = true); });
+    CHECK(got);
+  }
+  int streams = -1;
+  for (int i = 0; i < 100 && streams != 0; ++i) {
+    streams = open_streams();
+    if (streams != 0) std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  }
+  CHECK(streams == 0);  // within 10 s, six times less than the heartbeat
+  CHECK(c.Delete(("/api/v1/jobs/" + slow).c_str())->status == 202);
+  CHECK(c.Delete(("/api/v1/jobs/" + waiting).c_str())->status == 202);
+}
