@@ -1,8 +1,10 @@
 /// \file build_mesh.cpp
 /// Validation and repair of a reader's polygon soup into a TriMesh. Order: refuse non-finite
-/// points, short faces and bad indices; triangulate polygons; weld (if asked); drop degenerate
-/// and duplicate faces; refuse non-manifold edges; orient; split pinched vertices; drop
-/// unreferenced vertices; build the half-edge mesh.
+/// points, short faces and bad indices; triangulate polygons; weld (if asked); drop faces with a
+/// repeated vertex and duplicate faces (zero-area ones are kept, but those on an edge with more
+/// than two faces); refuse non-manifold edges; orient; split pinched vertices; drop unreferenced
+/// vertices; build the half-edge mesh; repair the zero-area faces on it (degenerate_faces.h),
+/// dropping those it cannot.
 
 #include <algorithm>
 #include <cmath>
@@ -10,6 +12,7 @@
 #include <string>
 #include <unordered_map>
 
+#include "io/degenerate_faces.h"
 #include "io/parse_util.h"
 #include "io/repair.h"
 
@@ -118,29 +121,23 @@ void weld(TriSoup& soup, std::vector<Repair>& repairs) {
                      std::to_string(welded) + " duplicate vertices at identical positions welded"});
 }
 
-/// Twice the area is below 1e-12 of the longest edge squared: zero within double rounding.
-/// Computed on points scaled by their largest coordinate so huge or tiny values cannot overflow.
-bool degenerate(const TriSoup& soup, const Tri& t) {
-  if (t[0] == t[1] || t[1] == t[2] || t[0] == t[2]) return true;
-  const Vec3 &a = soup.points[t[0]], &b = soup.points[t[1]], &c = soup.points[t[2]];
-  const double m = std::max({a.max_abs(), b.max_abs(), c.max_abs()});
-  if (!(m > 0)) return true;
-  const Vec3 sa = a / m, sb = b / m, sc = c / m;
-  const double twice_area = OpenMesh::cross(sb - sa, sc - sa).norm();
-  const double longest = std::max({(sb - sa).sqrnorm(), (sc - sb).sqrnorm(), (sa - sc).sqrnorm()});
-  return !(twice_area > 1e-12 * longest);
-}
+bool repeats_a_vertex(const Tri& t) { return t[0] == t[1] || t[1] == t[2] || t[0] == t[2]; }
 
-void drop_bad_faces(TriSoup& soup, const RawSoup& raw, std::vector<Repair>& repairs) {
-  std::size_t degenerate_count = 0, duplicate_count = 0;
-  std::string first_degenerate, first_duplicate;
+/// Drops faces with a repeated vertex and duplicates; flags the zero-area ones, kept for repair.
+void drop_bad_faces(TriSoup& soup, DroppedFaces& dropped, const RawSoup& raw, std::vector<Repair>& repairs) {
+  std::size_t duplicate_count = 0;
+  std::string first_duplicate;
   std::vector<bool> keep(soup.tris.size(), true);
-  for (std::size_t t = 0; t < soup.tris.size(); ++t)
-    if (degenerate(soup, soup.tris[t])) {
+  soup.zero_area.assign(soup.tris.size(), false);
+  for (std::size_t t = 0; t < soup.tris.size(); ++t) {
+    const Tri& tri = soup.tris[t];
+    if (repeats_a_vertex(tri)) {
       keep[t] = false;
-      if (degenerate_count++ == 0)
-        first_degenerate = "face " + std::to_string(soup.source[t]) + raw.face_where(soup.source[t]);
+      if (dropped.repeated++ == 0) dropped.first_repeated = soup.source[t];
+    } else if (zero_area(soup.points[tri[0]], soup.points[tri[1]], soup.points[tri[2]])) {
+      soup.zero_area[t] = true;
     }
+  }
   // Duplicates: the same three vertices in any order; the first one is kept.
   std::vector<std::pair<Tri, std::uint32_t>> keys;
   keys.reserve(soup.tris.size());
@@ -157,23 +154,32 @@ void drop_bad_faces(TriSoup& soup, const RawSoup& raw, std::vector<Repair>& repa
       if (duplicate_count++ == 0)
         first_duplicate = "face " + std::to_string(soup.source[keys[i].second]) + raw.face_where(soup.source[keys[i].second]);
     }
-  if (degenerate_count + duplicate_count == 0) return;
-  std::size_t out = 0;
-  for (std::size_t t = 0; t < soup.tris.size(); ++t)
-    if (keep[t]) {
-      soup.tris[out] = soup.tris[t];
-      soup.source[out++] = soup.source[t];
-    }
-  soup.tris.resize(out);
-  soup.source.resize(out);
-  if (degenerate_count > 0)
-    repairs.push_back({"degenerate_faces_removed", degenerate_count,
-                       std::to_string(degenerate_count) + " zero-area faces dropped (first: " + first_degenerate +
-                           "); where such a face closed the surface a hole is left, and the remeshed surface "
-                           "keeps it (--weld / weld=true merges coincident vertices first)"});
+  if (dropped.repeated + duplicate_count > 0) soup.retain(keep);
   if (duplicate_count > 0)
     repairs.push_back({"duplicate_faces_removed", duplicate_count,
                        std::to_string(duplicate_count) + " duplicate faces dropped (first: " + first_duplicate + ")"});
+}
+
+bool has_zero_area(const TriSoup& soup) {
+  return std::find(soup.zero_area.begin(), soup.zero_area.end(), true) != soup.zero_area.end();
+}
+
+/// check_edges_and_orient() with the zero-area faces kept; if it fails with them (one can close a
+/// cycle that cannot be oriented), again without any of them, as the input read before they were
+/// kept: nothing read then is refused now.
+std::vector<EdgeUse> orient(TriSoup& soup, DroppedFaces& dropped, const RawSoup& raw, std::vector<Repair>& repairs) {
+  if (!has_zero_area(soup)) return check_edges_and_orient(soup, raw, repairs);
+  const std::vector<Tri> before = soup.tris;
+  try {
+    return check_edges_and_orient(soup, raw, repairs);
+  } catch (const MeshError&) {
+    soup.tris = before;
+    std::vector<bool> keep(soup.tris.size(), true);
+    for (std::size_t t = 0; t < soup.tris.size(); ++t)
+      if (soup.zero_area[t]) keep[t] = false, dropped.add_zero_area(soup.source[t]);
+    soup.retain(keep);
+    return check_edges_and_orient(soup, raw, repairs);
+  }
 }
 
 /// Drops unreferenced points, renumbering the rest in order.
@@ -218,7 +224,110 @@ TriMesh assemble(const TriSoup& soup) {
   return mesh;
 }
 
+std::string face_name(const RawSoup& raw, std::uint32_t f) {
+  return "face " + std::to_string(f) + raw.face_where(f);
+}
+
+std::string plural(std::size_t n, const char* one, const char* many) {
+  return std::to_string(n) + " " + (n == 1 ? one : many);
+}
+
+/// Repairs the zero-area triangles on the half-edge mesh (degenerate_faces.h). Those it leaves are
+/// dropped through the soup again, which splits any vertex their going pinches. Appends the
+/// "degenerate_faces_repaired" report to `report`.
+TriMesh repair_zero_area(TriMesh mesh, const TriSoup& soup, DroppedFaces& dropped, const RawSoup& raw,
+                         std::vector<Repair>& report) {
+  std::vector<OpenMesh::FaceHandle> faces;
+  for (std::size_t t = 0; t < soup.tris.size(); ++t)
+    if (soup.zero_area[t]) faces.push_back(OpenMesh::FaceHandle(static_cast<int>(t)));
+  const ZeroAreaRepair r = repair_zero_area_faces(mesh, faces);
+  std::vector<bool> left(mesh.n_faces(), false);
+  for (const auto f : r.left) {
+    left[f.idx()] = true;
+    dropped.add_zero_area(soup.source[f.idx()]);
+  }
+  const std::size_t repaired = faces.size() > r.left.size() ? faces.size() - r.left.size() : 0;
+  if (repaired > 0) {
+    const auto first = std::find_if(faces.begin(), faces.end(), [&](auto f) { return !left[f.idx()]; });
+    report.push_back(
+        {"degenerate_faces_repaired", repaired,
+         plural(repaired, "zero-area face", "zero-area faces") + " repaired by collapsing their near-zero edge or "
+             "flipping the edge they lie on (or removing them where that edge is on the boundary), the surface kept "
+             "whole (first: " + face_name(raw, soup.source[first->idx()]) + "; " +
+             plural(r.collapses, "collapse", "collapses") + ", " + plural(r.flips, "flip", "flips") + ", " +
+             plural(r.boundary_deletions, "removal", "removals") + ")"});
+  }
+  if (r.left.empty()) {
+    collect_garbage(mesh);
+    mesh.update_normals();
+    return mesh;
+  }
+  TriSoup rest;
+  std::vector<std::uint32_t> index(mesh.n_vertices(), UINT32_MAX);
+  for (const auto v : mesh.vertices()) {
+    index[v.idx()] = static_cast<std::uint32_t>(rest.points.size());
+    rest.points.push_back(mesh.point(v));
+  }
+  for (const auto f : mesh.faces()) {
+    if (left[f.idx()]) continue;
+    Tri& tri = rest.tris.emplace_back();
+    int c = 0;
+    for (const auto v : mesh.fv_range(f)) tri[c++] = index[v.idx()];
+    rest.source.push_back(soup.source[f.idx()]);
+  }
+  free_mesh(mesh);
+  // Oriented and manifold already: nothing is refused or flipped. What remains to report (vertices
+  // split or left unused) goes into the report of the dropped faces.
+  std::vector<Repair> side;
+  const std::vector<EdgeUse> uses = check_edges_and_orient(rest, raw, side);
+  split_pinched_vertices(rest, uses, side);
+  compact(rest, side);
+  for (const Repair& s : side) {
+    if (s.kind == "nonmanifold_vertices_split") dropped.pinched += s.count;
+    if (s.kind == "unreferenced_vertices_removed") dropped.unused += s.count;
+  }
+  return assemble(rest);
+}
+
+/// The "degenerate_faces_removed" report.
+Repair dropped_report(const DroppedFaces& d, const RawSoup& raw) {
+  std::string detail = plural(d.repeated + d.zero_area, "degenerate face", "degenerate faces") + " dropped: ";
+  if (d.repeated > 0)
+    detail +=
+        std::to_string(d.repeated) + " with a repeated vertex (first: " + face_name(raw, d.first_repeated) + ")";
+  if (d.repeated > 0 && d.zero_area > 0) detail += ", ";
+  if (d.zero_area > 0) {
+    detail += std::to_string(d.zero_area) + " of zero area that could not be kept (an edge with more than 2 faces) "
+              "or repaired (first: " + face_name(raw, d.first_zero_area) + ")";
+    if (d.pinched > 0) detail += ", which left " + plural(d.pinched, "vertex", "vertices") + " pinched (split)";
+    if (d.unused > 0)
+      detail += (d.pinched > 0 ? " and " : ", which left ") + plural(d.unused, "vertex", "vertices") +
+                " unused (dropped)";
+    detail += "; where one closed the surface a hole may be left there, and the remeshed surface keeps it "
+              "(--weld / weld=true merges coincident vertices first)";
+  }
+  return {"degenerate_faces_removed", d.repeated + d.zero_area, detail};
+}
+
+[[noreturn]] void fail_no_surface(const RawSoup& raw) {
+  fail("all " + std::to_string(raw.face_count()) + " faces are degenerate or duplicates; no surface is left");
+}
+
 }  // namespace
+
+void TriSoup::retain(const std::vector<bool>& keep) {
+  std::size_t out = 0;
+  for (std::size_t t = 0; t < tris.size(); ++t)
+    if (keep[t]) {
+      tris[out] = tris[t];
+      source[out] = source[t];
+      if (!zero_area.empty()) zero_area[out] = zero_area[t];
+      ++out;
+    }
+  tris.resize(out);
+  source.resize(out);
+  if (!zero_area.empty()) zero_area.resize(out);
+}
 
 TriMesh build_mesh(RawSoup raw, const ReadOptions& options, std::vector<Repair>& repairs) {
   if (raw.face_count() == 0)
@@ -228,13 +337,21 @@ TriMesh build_mesh(RawSoup raw, const ReadOptions& options, std::vector<Repair>&
   TriSoup soup = triangulate(raw, options, repairs);
   check_face_limit(soup.tris.size(), options, "the triangulated mesh");
   if (options.weld) weld(soup, repairs);
-  drop_bad_faces(soup, raw, repairs);
-  if (soup.tris.empty())
-    fail("all " + std::to_string(raw.face_count()) + " faces are degenerate or duplicates; no surface is left");
-  const std::vector<EdgeUse> uses = check_edges_and_orient(soup, raw, repairs);
+  const std::size_t degenerate_at = repairs.size();  // their reports go here, once all are known
+  DroppedFaces dropped;
+  drop_bad_faces(soup, dropped, raw, repairs);
+  if (soup.tris.empty()) fail_no_surface(raw);
+  if (has_zero_area(soup)) drop_crowding_zero_area(soup, dropped);
+  const std::vector<EdgeUse> uses = orient(soup, dropped, raw, repairs);
   split_pinched_vertices(soup, uses, repairs);
   compact(soup, repairs);
-  return assemble(soup);
+  TriMesh mesh = assemble(soup);
+  std::vector<Repair> degenerate;
+  if (has_zero_area(soup)) mesh = repair_zero_area(std::move(mesh), soup, dropped, raw, degenerate);
+  if (dropped.repeated + dropped.zero_area > 0) degenerate.push_back(dropped_report(dropped, raw));
+  repairs.insert(repairs.begin() + static_cast<std::ptrdiff_t>(degenerate_at), degenerate.begin(), degenerate.end());
+  if (mesh.n_faces() == 0) fail_no_surface(raw);
+  return mesh;
 }
 
 }  // namespace remesh::io

@@ -20,8 +20,12 @@
 ///     duplicates; no surface is left").
 ///   repaired (Repair::kind, in this order): "polygons_triangulated" (ear clipping);
 ///     "vertices_welded" (only with ReadOptions::weld, never creating a non-manifold edge);
-///     "degenerate_faces_removed" (repeated vertex or zero area: twice the area <= 1e-12 *
-///     longest edge^2); "duplicate_faces_removed" (same vertex set in any order, the first kept);
+///     "degenerate_faces_repaired" (zero area: twice the area <= 1e-12 * longest edge^2; mended
+///     on the half-edge mesh keeping its topology: a needle's near-zero edge collapsed, the edge
+///     a cap lies on flipped, a cap on the boundary removed); "degenerate_faces_removed" (faces
+///     with a repeated vertex, and zero-area faces that would make an edge non-manifold or the
+///     surface non-orientable, or that no collapse or flip repairs: these can leave a hole);
+///     "duplicate_faces_removed" (same vertex set in any order, the first kept);
 ///     "faces_reoriented" (per connected component, the minority is flipped);
 ///     "nonmanifold_vertices_split" (one copy per extra fan of a pinched vertex);
 ///     "unreferenced_vertices_removed".

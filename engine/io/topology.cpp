@@ -144,6 +144,26 @@ std::vector<EdgeUse> check_edges_and_orient(TriSoup& soup, const RawSoup& raw, s
   return uses;
 }
 
+void drop_crowding_zero_area(TriSoup& soup, DroppedFaces& dropped) {
+  const std::vector<EdgeUse> uses = edge_uses(soup);
+  std::vector<bool> keep(soup.tris.size(), true);
+  bool any = false;
+  for (std::size_t i = 0; i < uses.size();) {
+    std::size_t j = i + 1;
+    while (j < uses.size() && uses[j].lo == uses[i].lo && uses[j].hi == uses[i].hi) ++j;
+    if (j - i > 2)
+      for (std::size_t k = i; k < j; ++k) {
+        const std::uint32_t t = uses[k].tri;
+        if (!soup.zero_area[t] || !keep[t]) continue;
+        keep[t] = false;
+        dropped.add_zero_area(soup.source[t]);
+        any = true;
+      }
+    i = j;
+  }
+  if (any) soup.retain(keep);
+}
+
 void split_pinched_vertices(TriSoup& soup, const std::vector<EdgeUse>& uses, std::vector<Repair>& repairs) {
   const std::size_t n = soup.tris.size();
   // Corners around a vertex are one fan when consecutive faces share an edge at that vertex.

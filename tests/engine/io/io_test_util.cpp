@@ -1,5 +1,6 @@
 #include "io_test_util.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 
@@ -166,6 +167,12 @@ std::vector<SampleFile> sample_files(const PolygonSoup& soup) {
   };
 }
 
+bool zero_area(const Vec3& a, const Vec3& b, const Vec3& c) {
+  const Vec3 e1 = b - a, e2 = c - a, e3 = c - b;
+  const double longest = std::max({e1.norm(), e2.norm(), e3.norm()});
+  return !(OpenMesh::cross(e1 / longest, e2 / longest).norm() > 1e-12);
+}
+
 std::string check_loaded(const TriMesh& mesh) {
   if (mesh.n_faces() == 0) return "no faces";
   for (auto v : mesh.vertices()) {
@@ -180,8 +187,7 @@ std::string check_loaded(const TriMesh& mesh) {
     auto h = mesh.halfedge_handle(f);
     auto a = mesh.from_vertex_handle(h), b = mesh.to_vertex_handle(h), c = mesh.to_vertex_handle(mesh.next_halfedge_handle(h));
     if (a == b || b == c || a == c) return "face with a repeated vertex";
-    const Vec3 e1 = mesh.point(b) - mesh.point(a), e2 = mesh.point(c) - mesh.point(a);
-    if (!(OpenMesh::cross(e1, e2).norm() > 0)) return "zero-area face " + std::to_string(f.idx());
+    if (zero_area(mesh.point(a), mesh.point(b), mesh.point(c))) return "zero-area face " + std::to_string(f.idx());
   }
   for (auto e : mesh.edges())
     if (mesh.is_boundary(mesh.halfedge_handle(e, 0)) && mesh.is_boundary(mesh.halfedge_handle(e, 1)))

@@ -31,8 +31,12 @@ std::string write_gltf_data_uri(const PolygonSoup& soup, const std::string& uri 
 /// A soup from explicit points and faces.
 PolygonSoup make_soup(const std::vector<Vec3>& points, const std::vector<std::vector<std::uint32_t>>& faces);
 
+/// Zero area as the reader defines it: twice the area <= 1e-12 x the longest edge squared
+/// (computed here on the plain differences of the points).
+bool zero_area(const Vec3& a, const Vec3& b, const Vec3& c);
+
 /// Empty if the loaded mesh keeps the reader's promises: at least one face, all faces triangles
-/// with three distinct vertices and positive area, finite points, every vertex manifold and
+/// with three distinct vertices and not of zero_area(), finite points, every vertex manifold and
 /// used, each edge with one or two faces, normals set. Otherwise the first problem.
 std::string check_loaded(const TriMesh& mesh);
 

@@ -4,6 +4,7 @@
 #include "io/mesh_io.h"
 #include "io/summary.h"
 #include "io_test_util.h"
+#include "support/mesh_generators.h"
 
 using namespace remesh;
 using Catch::Contains;
@@ -31,6 +32,13 @@ double signed_volume(const TriMesh& m) {
     v += OpenMesh::dot(a, OpenMesh::cross(b, c)) / 6;
   }
   return v;
+}
+
+/// "v x y z\n" with every digit: the points read back exactly.
+std::string obj_vertex(const Vec3& p) {
+  char buf[96];
+  std::snprintf(buf, sizeof buf, "v %.17g %.17g %.17g\n", p[0], p[1], p[2]);
+  return buf;
 }
 
 }  // namespace
@@ -71,25 +79,88 @@ TEST_CASE("Faces with fewer than 3 vertices are refused with the face and line")
                     Contains("face 0 (line 13)") && Contains("has 1 vertices"));
 }
 
-TEST_CASE("Degenerate and duplicate faces are dropped and counted") {
-  const std::string obj = kTetraVerts + "v 2 0 0\n" + kTetraFaces +
-                          "f 1 2 5\n"    // collinear: zero area
+TEST_CASE("Faces with a repeated vertex, zero-area faces on an edge with 2 other faces and duplicates are dropped") {
+  // The tetrahedron with its face 2 3 4 split at the middle of edge 2-3 and a cap over that point
+  // (repaired), then the faces to drop.
+  const std::string obj = kTetraVerts + "v 2 0 0\nv 0.5 0.5 0\n" +
+                          "f 1 3 2\nf 1 2 4\nf 1 4 3\nf 6 3 4\nf 2 6 4\n"
+                          "f 2 3 6\n"    // the cap, zero area
+                          "f 1 2 5\n"    // collinear, on edge 1-2 with its 2 faces: would make a third
                           "f 1 1 2\n"    // repeated vertex
                           "f 1 2 4\n"    // exact duplicate
                           "f 4 2 1\n";   // same vertices, reversed
-  LoadedMesh m = read(obj);
-  CHECK(m.mesh.n_faces() == 4);
+  LoadedMesh m;
+  REQUIRE_NOTHROW(m = read(obj));
   const Repair* d = find_repair(m, "degenerate_faces_removed");
   REQUIRE(d);
   CHECK(d->count == 2);
-  CHECK_THAT(d->detail, Contains("face 4 (line 10)"));
+  CHECK_THAT(d->detail, Contains("1 with a repeated vertex (first: face 7 (line 14))") &&
+                            Contains("1 of zero area") && Contains("face 6 (line 13)") && Contains("--weld"));
+  const Repair* c = find_repair(m, "degenerate_faces_repaired");  // the cap: dropping the other kept it
+  REQUIRE(c);
+  CHECK(c->count == 1);
+  CHECK_THAT(c->detail, Contains("face 5 (line 12)") && Contains("1 flip"));
   const Repair* u = find_repair(m, "duplicate_faces_removed");
   REQUIRE(u);
   CHECK(u->count == 2);
-  const Repair* r = find_repair(m, "unreferenced_vertices_removed");  // vertex 5 only had a degenerate face
+  const Repair* r = find_repair(m, "unreferenced_vertices_removed");  // vertex 5 only had a dropped face
   REQUIRE(r);
   CHECK(r->count == 1);
   CHECK(test::check_loaded(m.mesh).empty());
+  CHECK(m.mesh.n_faces() == 6);
+  CHECK(test::euler_characteristic(m.mesh) == 2);
+  CHECK(test::count_boundary_loops(m.mesh) == 0);
+}
+
+TEST_CASE("Zero-area faces that would make a surface non-orientable are dropped and it reads") {
+  // A band whose ends meet with a half twist at separate, coincident vertices (open, orientable),
+  // closed into a Moebius strip by two needles across the seam: kept, the strip could not be
+  // oriented. Without them it reads, as it did before zero-area faces were kept.
+  std::string obj;
+  const int n = 12;
+  for (int i = 0; i <= n; ++i) {
+    const double t = 2 * M_PI * i / n, w = 0.3;
+    for (int s : {-1, 1}) {
+      const double r = 1 + s * w * std::cos(t / 2);
+      obj += obj_vertex(Vec3(r * std::cos(t), r * std::sin(t), s * w * std::sin(t / 2)));
+    }
+  }
+  for (int i = 0; i < n; ++i) {
+    const int a = 2 * i + 1, b = 2 * i + 2, c = 2 * i + 3, d = 2 * i + 4;
+    obj += "f " + std::to_string(a) + " " + std::to_string(c) + " " + std::to_string(b) + "\n";
+    obj += "f " + std::to_string(b) + " " + std::to_string(c) + " " + std::to_string(d) + "\n";
+  }
+  const int a0 = 1, b0 = 2, an = 2 * n + 1, bn = 2 * n + 2;  // an at b0's position, bn at a0's
+  obj += "f " + std::to_string(a0) + " " + std::to_string(b0) + " " + std::to_string(an) + "\n";
+  obj += "f " + std::to_string(a0) + " " + std::to_string(an) + " " + std::to_string(bn) + "\n";
+  LoadedMesh m;
+  REQUIRE_NOTHROW(m = read(obj));
+  const Repair* d = find_repair(m, "degenerate_faces_removed");
+  REQUIRE(d);
+  CHECK(d->count == 2);
+  CHECK(m.mesh.n_faces() == 2 * n);
+  CHECK(test::check_loaded(m.mesh).empty());
+  CHECK(test::count_boundary_loops(m.mesh) == 1);
+}
+
+TEST_CASE("A zero-area face no operation repairs is dropped with a warning that names --weld") {
+  // A lone collinear triangle beside a tetrahedron: removing it would remove its component.
+  LoadedMesh m = read(kTetraVerts + kTetraFaces + "v 5 0 0\nv 6 0 0\nv 7 0 0\nf 5 6 7\n");
+  const Repair* d = find_repair(m, "degenerate_faces_removed");
+  REQUIRE(d);
+  CHECK(d->count == 1);
+  CHECK_THAT(d->detail, Contains("face 4 (line 12)") && Contains("hole") && Contains("--weld / weld=true") &&
+                            Contains("3 vertices unused"));
+  CHECK(m.mesh.n_faces() == 4);
+  CHECK(m.mesh.n_vertices() == 4);
+  CHECK(test::check_loaded(m.mesh).empty());
+  // The same 1e-14 across, far from the origin: its edges are measured, not its points (scaled
+  // points carry rounding of 1e-16 of their size into it).
+  const Vec3 p(0.1, 0.9, -0.4), step(std::ldexp(1.0, -46), std::ldexp(1.0, -46), std::ldexp(1.0, -47));
+  LoadedMesh tiny = read(kTetraVerts + kTetraFaces + obj_vertex(p) + obj_vertex(p + step) +
+                         obj_vertex(p + 2 * step) + "f 5 6 7\n");
+  CHECK(tiny.mesh.n_faces() == 4);
+  CHECK(test::check_loaded(tiny.mesh).empty());
 }
 
 TEST_CASE("Unreferenced vertices are dropped and counted") {
@@ -268,4 +339,177 @@ TEST_CASE("Welding stops where it would make an edge non-manifold") {
   CHECK(s.components == 4);
   CHECK(m.mesh.n_faces() == 5);
   CHECK(test::check_loaded(m.mesh).empty());
+}
+
+// Zero-area faces repaired without opening the surface: closed meshes stay closed, open ones keep
+// their boundary loops, over a set of meshes (closed genus 0, 1, 2 and open).
+namespace {
+
+struct Edited {
+  std::vector<Vec3> points;
+  std::vector<std::vector<std::uint32_t>> faces;
+  std::size_t zero_area = 0;  ///< zero-area faces added
+};
+
+Edited faces_of(const TriMesh& mesh) {
+  Edited e;
+  for (auto v : mesh.vertices()) e.points.push_back(mesh.point(v));
+  for (auto f : mesh.faces()) {
+    auto& face = e.faces.emplace_back();
+    for (auto v : mesh.fv_range(f)) face.push_back(static_cast<std::uint32_t>(v.idx()));
+  }
+  return e;
+}
+
+/// Vertices, boundary or interior, whose one-rings do not touch: edits at each stay apart.
+std::vector<TriMesh::VertexHandle> spread_vertices(const TriMesh& mesh, bool interior, std::size_t count) {
+  std::vector<bool> near(mesh.n_vertices(), false);
+  std::vector<TriMesh::VertexHandle> out;
+  for (auto v : mesh.vertices()) {
+    if (out.size() == count) break;
+    if (near[v.idx()] || (interior && mesh.is_boundary(v))) continue;
+    bool free = true;
+    for (auto w : mesh.vv_range(v)) free = free && !near[w.idx()];
+    if (!free) continue;
+    out.push_back(v);
+    for (auto w : mesh.vv_range(v)) {
+      near[w.idx()] = true;
+      for (auto x : mesh.vv_range(w)) near[x.idx()] = true;
+    }
+    near[v.idx()] = true;
+  }
+  return out;
+}
+
+/// How far a vertex's copy is from it.
+enum class Offset { None, Relative, AlongEdge };
+
+/// Splits interior vertex v into v and a copy (at v, 1e-14 of v's position away, or 2e-12 of the
+/// edge to its first neighbour along it), each taking half of its fan, and closes the slit between
+/// them with two needle triangles.
+void add_needles(const TriMesh& mesh, TriMesh::VertexHandle v, Offset offset, Edited& e) {
+  std::vector<TriMesh::HalfedgeHandle> fan;  // outgoing, counter-clockwise
+  for (auto h : mesh.voh_ccw_range(v)) fan.push_back(h);
+  const auto copy = static_cast<std::uint32_t>(e.points.size());
+  const Vec3 p = mesh.point(v), along = mesh.point(mesh.to_vertex_handle(fan[0])) - p;
+  e.points.push_back(offset == Offset::None       ? p
+                     : offset == Offset::Relative ? p * (1 + 1e-14)
+                                                  : p + along * 2e-12);
+  const std::size_t half = fan.size() / 2;
+  for (std::size_t i = half; i < fan.size(); ++i)
+    for (auto& c : e.faces[mesh.face_handle(fan[i]).idx()])
+      if (c == static_cast<std::uint32_t>(v.idx())) c = copy;
+  const auto vi = static_cast<std::uint32_t>(v.idx());
+  const auto w0 = static_cast<std::uint32_t>(mesh.to_vertex_handle(fan[0]).idx());
+  const auto wh = static_cast<std::uint32_t>(mesh.to_vertex_handle(fan[half]).idx());
+  e.faces.push_back({vi, wh, copy});
+  e.faces.push_back({copy, w0, vi});
+  // A copy along the edge to w0: that needle lies on it; the other is 2e-12 x sin(angle between the
+  // edges to w0 and wh) thin, of zero area where they are nearly opposite (sin < about 1/2).
+  for (const std::uint32_t w : {wh, w0}) e.zero_area += test::zero_area(e.points[vi], e.points[w], e.points[copy]);
+}
+
+/// Puts `n` points on the edge of h (b -> a), splits h's face (b, a, y) at them and fills the
+/// flat polygon (b, a, points...) between the points and the edge with n caps, whose longest edge
+/// a-b is the edge of the face across h, or the boundary.
+void add_caps(const TriMesh& mesh, TriMesh::HalfedgeHandle h, int n, Edited& e) {
+  const auto b = static_cast<std::uint32_t>(mesh.from_vertex_handle(h).idx());
+  const auto a = static_cast<std::uint32_t>(mesh.to_vertex_handle(h).idx());
+  const auto y = static_cast<std::uint32_t>(mesh.to_vertex_handle(mesh.next_halfedge_handle(h)).idx());
+  std::vector<std::uint32_t> q{a};
+  for (int i = 1; i <= n; ++i) {
+    q.push_back(static_cast<std::uint32_t>(e.points.size()));
+    e.points.push_back(e.points[a] + (e.points[b] - e.points[a]) * (double(i) / (n + 1)));
+  }
+  q.push_back(b);
+  e.faces[mesh.face_handle(h).idx()] = {q[1], q[0], y};
+  for (int i = 1; i <= n; ++i) e.faces.push_back({q[i + 1], q[i], y});
+  for (int i = 0; i < n; ++i) e.faces.push_back({b, q[i], q[i + 1]});
+  e.zero_area += n;
+}
+
+struct Topology {
+  long euler;
+  std::size_t boundary_loops, components;
+  bool operator==(const Topology&) const = default;
+};
+std::ostream& operator<<(std::ostream& os, const Topology& t) {
+  return os << "{euler " << t.euler << ", boundary loops " << t.boundary_loops << ", components " << t.components
+            << "}";
+}
+Topology topology(const TriMesh& m) {
+  return {test::euler_characteristic(m), test::count_boundary_loops(m), test::count_components(m)};
+}
+
+/// Reads the edited mesh; checks it valid, with the original's topology and no zero-area face,
+/// and every added zero-area face repaired.
+void check_repaired(const TriMesh& original, const Edited& e) {
+  const std::string obj = write_mesh(test::make_soup(e.points, e.faces), Format::Obj);
+  LoadedMesh m = read(obj);
+  CHECK(topology(m.mesh) == topology(original));
+  CHECK(test::check_loaded(m.mesh).empty());
+  CHECK(test::check_mesh_valid(m.mesh, 1e-6).empty());  // no face below 1e-6 of the mean area, none folded
+  const Repair* r = find_repair(m, "degenerate_faces_repaired");
+  REQUIRE(r);
+  CHECK(r->count == e.zero_area);
+  CHECK(find_repair(m, "degenerate_faces_removed") == nullptr);
+  std::size_t faces = 0;
+  for (auto f : m.mesh.all_faces()) faces += m.mesh.status(f).deleted() ? 0 : 1;
+  CHECK(faces == m.mesh.n_faces());  // garbage collected
+}
+
+std::vector<std::pair<std::string, TriMesh>> meshes_to_edit() {
+  return {{"icosphere", test::make_icosphere(2)},
+          {"torus", test::make_torus(24, 12, 1.0, 0.4)},
+          {"double torus", test::make_double_torus(1.0, 2)},
+          {"open grid", test::make_open_grid(12, 12, 1.0)}};
+}
+
+}  // namespace
+
+TEST_CASE("Needles between near-coincident vertex copies are collapsed and the surface stays closed") {
+  for (const auto& [name, mesh] : meshes_to_edit()) {
+    INFO(name);
+    Edited e = faces_of(mesh);
+    const auto chosen = spread_vertices(mesh, /*interior=*/true, 6);
+    REQUIRE(chosen.size() == 6);
+    for (std::size_t i = 0; i < chosen.size(); ++i)
+      add_needles(mesh, chosen[i], std::array{Offset::None, Offset::Relative, Offset::AlongEdge}[i % 3], e);
+    check_repaired(mesh, e);
+    // Each copy went back into its vertex: the vertices are the original ones.
+    const std::string obj = write_mesh(test::make_soup(e.points, e.faces), Format::Obj);
+    CHECK(read(obj).mesh.n_vertices() == mesh.n_vertices());
+  }
+}
+
+TEST_CASE("Caps over points on an edge are flipped away and a closed surface stays closed") {
+  for (const auto& [name, mesh] : meshes_to_edit()) {
+    INFO(name);
+    Edited e = faces_of(mesh);
+    int n = 1;
+    for (auto v : spread_vertices(mesh, /*interior=*/true, 4)) {
+      // An interior edge: its halfedge out of v, whose face is split.
+      add_caps(mesh, *mesh.voh_range(v).begin(), n, e);
+      n = n % 3 + 1;  // 1, 2 or 3 collinear points on the edge
+    }
+    check_repaired(mesh, e);
+  }
+}
+
+TEST_CASE("Caps on the boundary are removed and the boundary loops stay") {
+  const TriMesh mesh = test::make_open_grid(8, 8, 1.0);
+  Edited e = faces_of(mesh);
+  int n = 1;
+  for (auto v : spread_vertices(mesh, /*interior=*/false, 40)) {
+    if (!mesh.is_boundary(v)) continue;
+    for (auto h : mesh.voh_range(v))
+      if (mesh.is_boundary(mesh.opposite_halfedge_handle(h)) && !mesh.is_boundary(h)) {
+        add_caps(mesh, h, n, e);  // the face along the boundary split, caps between it and the boundary
+        n = n % 3 + 1;
+        break;
+      }
+  }
+  REQUIRE(e.zero_area >= 6);
+  check_repaired(mesh, e);
+  CHECK(test::count_boundary_loops(mesh) == 1);
 }
