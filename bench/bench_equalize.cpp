@@ -238,6 +238,7 @@ constexpr double kSpread[][2] = {{1.2, 1.8}, {1.19, 1.79}, {1.21, 1.81}, {1.2, 1
 void run_spread(const std::string& name, const std::string& scaled, const TriMesh& input, const ChildResult& first,
                 double first_h, const Options& o, const fs::path& dir) {
   double inside_sum = 0, inside_min = 100, regular_sum = 0, regular_min = 100, h_sum = 0, h_max = 0, seconds = 0;
+  std::size_t crossings = 0;
   int runs = 0;
   const double diagonal = bench::bbox_diagonal(input);
   for (const auto& [e_min, e_max] : kSpread) {
@@ -253,8 +254,11 @@ void run_spread(const std::string& name, const std::string& scaled, const TriMes
     const IterationStats s = measure(output, e_min, e_max, o.threads);
     const double h =
         standard ? first_h : 100 * bench::hausdorff_distance(input, output, o.samples, o.threads) / diagonal;
-    std::printf("ours [%.2f, %.2f]: inside %.3f %%, regular %.2f %%, Hausdorff %.4f %%, %d it, total %.3f s\n", e_min,
-                e_max, 100 * s.inside_fraction, s.regular_percent, h, r.iterations, r.seconds);
+    const std::size_t crossing = find_self_intersections(output, o.threads).size();
+    std::printf("ours [%.2f, %.2f]: inside %.3f %%, regular %.2f %%, Hausdorff %.4f %%, %d it, total %.3f s, "
+                "crossing face pairs %zu\n",
+                e_min, e_max, 100 * s.inside_fraction, s.regular_percent, h, r.iterations, r.seconds, crossing);
+    crossings += crossing;
     inside_sum += 100 * s.inside_fraction, inside_min = std::min(inside_min, 100 * s.inside_fraction);
     regular_sum += s.regular_percent, regular_min = std::min(regular_min, s.regular_percent);
     h_sum += h, h_max = std::max(h_max, h), seconds += r.seconds;
@@ -262,9 +266,9 @@ void run_spread(const std::string& name, const std::string& scaled, const TriMes
   }
   if (runs > 0)
     std::printf("ours over %d intervals: inside mean %.3f %% (lowest %.3f), regular mean %.2f %% (lowest %.2f), "
-                "Hausdorff mean %.4f %% (highest %.4f), mean total %.3f s\n",
+                "Hausdorff mean %.4f %% (highest %.4f), mean total %.3f s, crossing face pairs %zu in all\n",
                 runs, inside_sum / runs, inside_min, regular_sum / runs, regular_min, h_sum / runs, h_max,
-                seconds / runs);
+                seconds / runs, crossings);
 }
 
 #ifdef REMESH_BENCH_HAS_CGAL

@@ -60,7 +60,8 @@ bool is_corner(const TriMesh& mesh, OpenMesh::VertexHandle v) {
   return std::abs(geom::angle_deficit(mesh, v)) > kCornerDeficit;
 }
 
-std::vector<Vec3> low_pass_displacements(const TriMesh& mesh, int rings, unsigned threads) {
+std::vector<Vec3> low_pass_displacements(const TriMesh& mesh, int rings, unsigned threads,
+                                         const CreaseLines* creases, double tol) {
   const std::vector<Vec3> normals = geom::vertex_normals(mesh, threads);
   std::vector<Vec3> moves(mesh.n_vertices(), Vec3(0, 0, 0));
   parallel_for(mesh.n_vertices(), threads, [&](std::size_t i) {
@@ -68,6 +69,14 @@ std::vector<Vec3> low_pass_displacements(const TriMesh& mesh, int rings, unsigne
     if (mesh.status(v).deleted() || mesh.is_boundary(v)) return;  // isolated counts as boundary
     if (is_corner(mesh, v)) return;
     Vec3 t = ring_centroid(mesh, v, rings) - mesh.point(v);
+    if (creases && !creases->empty()) {
+      const CreaseLines::Where where = creases->locate(mesh.point(v), tol);
+      if (where.kind == CreaseLines::Kind::Corner) return;
+      if (where.kind == CreaseLines::Kind::Line) {
+        moves[i] = where.direction * (t | where.direction);
+        return;
+      }
+    }
     const Vec3& n = normals[i];
     t -= n * (t | n);
     moves[i] = t;
@@ -75,8 +84,8 @@ std::vector<Vec3> low_pass_displacements(const TriMesh& mesh, int rings, unsigne
   return moves;
 }
 
-double low_pass_filter(TriMesh& mesh, int rings, unsigned threads) {
-  const std::vector<Vec3> moves = low_pass_displacements(mesh, rings, threads);
+double low_pass_filter(TriMesh& mesh, int rings, unsigned threads, const CreaseLines* creases, double tol) {
+  const std::vector<Vec3> moves = low_pass_displacements(mesh, rings, threads, creases, tol);
   double worst = 0;
   for (std::size_t i = 0; i < moves.size(); ++i) {
     mesh.point(mesh.vertex_handle(static_cast<unsigned>(i))) += moves[i];

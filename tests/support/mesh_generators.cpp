@@ -105,6 +105,26 @@ TriMesh make_fan(int sectors, double radius) {
   return m;
 }
 
+TriMesh make_sliver_cylinder(int segments, double radius, double height) {
+  TriMesh m;
+  const VH bottom = m.add_vertex(Vec3(0, 0, 0)), top = m.add_vertex(Vec3(0, 0, height));
+  std::vector<VH> lo, hi;
+  for (int i = 0; i < segments; ++i) {
+    const double a = 2 * M_PI * i / segments;
+    lo.push_back(m.add_vertex(Vec3(radius * std::cos(a), radius * std::sin(a), 0)));
+    hi.push_back(m.add_vertex(Vec3(radius * std::cos(a), radius * std::sin(a), height)));
+  }
+  for (int i = 0; i < segments; ++i) {
+    const int j = (i + 1) % segments;
+    add_tri(m, bottom, lo[j], lo[i]);
+    add_tri(m, top, hi[i], hi[j]);
+    add_tri(m, lo[i], lo[j], hi[j]);
+    add_tri(m, lo[i], hi[j], hi[i]);
+  }
+  m.update_normals();
+  return m;
+}
+
 TriMesh make_hex_lattice_patch(int rows, int cols, double spacing) {
   TriMesh m;
   std::vector<VH> vh;

@@ -27,6 +27,9 @@ TriMesh make_double_torus(double cell = 1.0, int sub = 2);
 /// Flat disk of `radius` in z = 0 triangulated as a fan: `sectors` triangles around a centre vertex
 /// (a cap as CAD exports write it; above 360 sectors every triangle has an angle below 1 degree).
 TriMesh make_fan(int sectors, double radius);
+/// Closed cylinder (axis z, from 0 to `height`) as CAD exports write it: `segments` flat side facets,
+/// each two slivers from rim to rim, and caps that are fans around a centre vertex.
+TriMesh make_sliver_cylinder(int segments, double radius, double height);
 
 /// Empty if `mesh` is valid: no deleted elements left, every vertex manifold, every face a
 /// non-degenerate triangle (area > area_eps * mean area), no folded pair of adjacent triangles

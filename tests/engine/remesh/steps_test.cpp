@@ -8,6 +8,7 @@
 #include <stop_token>
 #include <vector>
 
+#include "remesh/crease_lines.h"
 #include "remesh/fold_guard.h"
 #include "remesh/geometry.h"
 #include "remesh/interval_cleanup.h"
@@ -428,6 +429,71 @@ TEST_CASE("the filter moves vertices tangentially only and never moves boundary 
     }
     CHECK(largest > 1e-4);
   }
+}
+
+TEST_CASE("the reference's creases are lines of sharp edges, with corners where they end or bend", "[steps]") {
+  const double tol = 1e-9;
+  SECTION("a cylinder of 128 segments: its rims") {
+    const TriMesh cylinder = test::make_sliver_cylinder(128, 1.0, 2.0);
+    const CreaseLines creases(cylinder);
+    CHECK(creases.size() == 256);  // the rims; the side facets meet at 2.8 degrees
+    for (int i = 0; i < 128; i += 17) {
+      const double a = 2 * M_PI * i / 128, b = 2 * M_PI * (i + 1) / 128;
+      const Vec3 p(std::cos(a), std::sin(a), 2.0), q(std::cos(b), std::sin(b), 2.0);
+      // A rim vertex: a bend of 2.8 degrees, the line goes on along the rim's tangent.
+      const CreaseLines::Where at = creases.locate(p, tol);
+      REQUIRE(at.kind == CreaseLines::Kind::Line);
+      CHECK(std::abs(at.direction | Vec3(std::cos(a), std::sin(a), 0)) < 1e-9);
+      CHECK(std::abs(at.direction[2]) < 1e-12);
+      // Between two rim vertices: along their segment.
+      const CreaseLines::Where mid = creases.locate(0.3 * p + 0.7 * q, tol);
+      REQUIRE(mid.kind == CreaseLines::Kind::Line);
+      CHECK(std::abs(std::abs(mid.direction | (q - p).normalized()) - 1) < 1e-12);
+    }
+    CHECK(creases.locate(Vec3(0, 0, 2), tol).kind == CreaseLines::Kind::None);  // the cap's centre
+    CHECK(creases.locate(Vec3(1, 0, 1), tol).kind == CreaseLines::Kind::None);  // on the side
+    CHECK(creases.locate(Vec3(1, 0, 2 - 1e-6), tol).kind == CreaseLines::Kind::None);
+  }
+  SECTION("a cylinder of 10 segments: its rims bend by 36 degrees at every vertex") {
+    const TriMesh cylinder = test::make_sliver_cylinder(10, 1.0, 2.0);
+    const CreaseLines creases(cylinder);
+    CHECK(creases.size() == 20);
+    CHECK(creases.locate(Vec3(1, 0, 0), tol).kind == CreaseLines::Kind::Corner);
+    const Vec3 q(std::cos(2 * M_PI / 10), std::sin(2 * M_PI / 10), 0);
+    CHECK(creases.locate(0.5 * (Vec3(1, 0, 0) + q), tol).kind == CreaseLines::Kind::Line);
+  }
+  SECTION("a spike is no crease: fewer than kMinCreaseEdges sharp edges together") {
+    TriMesh grid = test::make_open_grid(8, 8, 1.0);
+    OpenMesh::VertexHandle spike;
+    for (auto v : grid.vertices())
+      if (grid.point(v) == Vec3(3, 4, 0)) spike = v;
+    REQUIRE(spike.is_valid());
+    REQUIRE(grid.valence(spike) == 4);
+    grid.point(spike)[2] = 3;  // 8 edges of about 90 degrees: its 4 spokes and the 4 around them
+    CHECK(CreaseLines(grid).empty());
+  }
+}
+
+TEST_CASE("the filter moves a vertex on a crease along it only", "[steps]") {
+  const TriMesh cylinder = test::make_sliver_cylinder(128, 1.0, 2.0);
+  const CreaseLines creases(cylinder);
+  const auto free = low_pass_displacements(cylinder, 2, 2);
+  const auto held = low_pass_displacements(cylinder, 2, 2, &creases, 1e-9);
+  std::size_t rim = 0, across = 0;
+  for (auto v : cylinder.vertices()) {
+    const Vec3 p = cylinder.point(v);
+    if (std::abs(std::hypot(p[0], p[1]) - 1) > 1e-12) {  // a cap's centre: as without creases
+      CHECK(held[v.idx()] == free[v.idx()]);
+      continue;
+    }
+    ++rim;
+    const Vec3 tangent(-p[1], p[0], 0);
+    CHECK((held[v.idx()] % tangent).norm() <= 1e-12 * (1 + held[v.idx()].norm()));
+    // Without the creases the filter pulls every rim vertex off the rim (towards the cap's centre).
+    across += (free[v.idx()] % tangent).norm() > 1e-3;
+  }
+  CHECK(rim == 256);
+  CHECK(across == 256);
 }
 
 TEST_CASE("the interval guard moves back, half way at a time, what took edges out of the interval", "[steps]") {
