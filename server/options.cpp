@@ -12,6 +12,10 @@ namespace remeshd {
 
 namespace {
 
+/// The longest heartbeat and stream lifetime, a day: an event stream's waits are time points, and
+/// --heartbeat-seconds 1e10 overflowed them (the stream then pinged in a busy loop).
+constexpr double kMaxStreamSeconds = 86400;
+
 /// One option: its name (also the env name REMESHD_<NAME upper, '-' -> '_'>), help, setter.
 struct Spec {
   const char* name;
@@ -87,12 +91,14 @@ const std::vector<Spec>& specs() {
       {"stream-lifetime-seconds", "S", "an event stream ends after S seconds; clients reconnect (default 300)",
        [](Options& o, const std::string& v) {
          o.stream_lifetime_seconds = to_double("stream-lifetime-seconds", v);
-         if (o.stream_lifetime_seconds < 1) throw std::invalid_argument("--stream-lifetime-seconds: at least 1");
+         if (!(o.stream_lifetime_seconds >= 1 && o.stream_lifetime_seconds <= kMaxStreamSeconds))
+           throw std::invalid_argument("--stream-lifetime-seconds: 1 to 86400");
        }},
       {"heartbeat-seconds", "S", "': ping' comment interval on idle streams (default 15)",
        [](Options& o, const std::string& v) {
          o.heartbeat_seconds = to_double("heartbeat-seconds", v);
-         if (o.heartbeat_seconds < 0.1) throw std::invalid_argument("--heartbeat-seconds: at least 0.1");
+         if (!(o.heartbeat_seconds >= 0.1 && o.heartbeat_seconds <= kMaxStreamSeconds))
+           throw std::invalid_argument("--heartbeat-seconds: 0.1 to 86400");
        }},
   };
   return s;

@@ -114,12 +114,33 @@ class Repairer {
     if (ba != bb ? ba : a.idx() < b.idx()) h = mesh_.opposite_halfedge_handle(h);
     if (mesh_.is_boundary(mesh_.edge_handle(h)) && !boundary_loop_longer_than_3(h)) return false;
     for (const HalfedgeHandle g : {h, mesh_.opposite_halfedge_handle(h)}) {
-      if (!mesh_.is_collapse_ok(g)) continue;
+      if (!mesh_.is_collapse_ok(g) || turns_a_face(g)) continue;
       const VertexHandle kept = mesh_.to_vertex_handle(g);
       mesh_.collapse(g);
       ++result_.collapses;
       for (const FaceHandle f : mesh_.vf_range(kept)) enqueue(f);
       return true;
+    }
+    return false;
+  }
+
+  /// Would collapsing g (its from-vertex onto its to-vertex) turn a face around the from-vertex
+  /// over? The ends lie within 1e-6 of the needle's longest edge of each other, but a face smaller
+  /// than that beside them can still flip (a needle 1000 long beside faces 1e-4 across).
+  bool turns_a_face(HalfedgeHandle g) const {
+    const VertexHandle from = mesh_.from_vertex_handle(g), to = mesh_.to_vertex_handle(g);
+    const FaceHandle gone0 = mesh_.face_handle(g), gone1 = mesh_.opposite_face_handle(g);
+    for (const FaceHandle f : mesh_.vf_range(from)) {
+      if (f == gone0 || f == gone1) continue;
+      Vec3 before[3], after[3];
+      int k = 0;
+      for (const VertexHandle v : mesh_.fv_range(f)) {
+        before[k] = mesh_.point(v);
+        after[k++] = v == from ? mesh_.point(to) : mesh_.point(v);
+      }
+      const Vec3 n0 = OpenMesh::cross(before[1] - before[0], before[2] - before[0]);
+      const Vec3 n1 = OpenMesh::cross(after[1] - after[0], after[2] - after[0]);
+      if ((n0 | n1) < 0) return true;
     }
     return false;
   }

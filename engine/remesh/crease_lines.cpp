@@ -1,6 +1,8 @@
 #include "remesh/crease_lines.h"
 
 #include <algorithm>
+#include <climits>
+#include <cstdint>
 #include <cmath>
 #include <numeric>
 #include <utility>
@@ -72,34 +74,40 @@ CreaseLines::CreaseLines(const TriMesh& reference, const std::vector<OpenMesh::E
     at[b].push_back(static_cast<std::uint32_t>(segments_.size()));
     segments_.push_back({a, b});
   }
-  // Points along each segment at most `step` apart (the median segment's length): a point within
-  // tol of a segment is within step / 2 + tol of one of its samples, so a query looks at a few
-  // samples even where some creases are hundreds of times longer than the rest (cheese).
-  const double step = median_length(reference, edges);
+  // Points along each segment at most `step` apart: a point within tol of a segment is within
+  // step / 2 + tol of one of its samples. The step is the median segment's length, so a query
+  // looks at a few samples even where some creases are hundreds of times longer than the rest
+  // (cheese), but at least 1/16 of the mean, so that a few long creases beside many short ones
+  // cannot make the samples many (a 48-face prism 1e7 long, its caps' edges cut in 4: 4.5 GB).
+  double total = 0;
+  for (const Segment& g : segments_) total += (points_[g.a] - points_[g.b]).norm();
+  const double step =
+      segments_.empty() ? 0 : std::max(median_length(reference, edges), total / (16.0 * static_cast<double>(segments_.size())));
   std::vector<Vec3> samples;
-  for (std::uint32_t s = 0; s < segments_.size(); ++s) {
-    const Vec3 &a = points_[segments_[s].a], &b = points_[segments_[s].b];
-    const auto pieces = static_cast<std::size_t>(std::ceil((b - a).norm() / step));
-    for (std::size_t k = 0; k <= std::max<std::size_t>(pieces, 1); ++k) {
-      samples.push_back(a + (b - a) * (static_cast<double>(k) / static_cast<double>(std::max<std::size_t>(pieces, 1))));
-      sample_segment_.push_back(s);
+  for (std::uint32_t g = 0; g < segments_.size(); ++g) {
+    const Vec3 &pa = points_[segments_[g].a], &pb = points_[segments_[g].b];
+    // At most 17 samples a segment on average; a segment of length 0 (of no valid mesh) has its ends.
+    const double pieces = step > 0 ? std::max(1.0, std::ceil((pb - pa).norm() / step)) : 1.0;
+    for (double k = 0; k <= pieces; ++k) {
+      samples.push_back(pa + (pb - pa) * (k / pieces));
+      sample_segment_.push_back(g);
     }
   }
   reach_ = 0.5 * step;
   samples_ = PointIndex(std::move(samples));
   corner_.assign(points_.size(), 0);
-  through_.assign(points_.size(), Vec3(0, 0, 0));
-  for (std::uint32_t p = 0; p < points_.size(); ++p) {
-    if (at[p].empty()) continue;
-    if (at[p].size() != 2) {
-      corner_[p] = 1;
+  along_.assign(points_.size(), {0, 0});
+  for (std::uint32_t q = 0; q < points_.size(); ++q) {
+    if (at[q].empty()) continue;
+    auto other = [&](std::uint32_t g) { return segments_[g].a == q ? segments_[g].b : segments_[g].a; };
+    if (at[q].size() != 2) {
+      corner_[q] = 1;
       continue;
     }
-    auto other = [&](std::uint32_t s) { return segments_[s].a == p ? segments_[s].b : segments_[s].a; };
-    const Vec3 in = (points_[p] - points_[other(at[p][0])]).normalized();
-    const Vec3 out = (points_[other(at[p][1])] - points_[p]).normalized();
-    if ((in | out) < std::cos(kCreaseBend)) corner_[p] = 1;
-    else through_[p] = (in + out).normalized();
+    const Vec3 in = points_[q] - points_[other(at[q][0])], out = points_[other(at[q][1])] - points_[q];
+    const double lengths = in.norm() * out.norm();
+    if (!(lengths > 0) || (in | out) < std::cos(kCreaseBend) * lengths) corner_[q] = 1;
+    else along_[q] = {other(at[q][0]), other(at[q][1])};
   }
 }
 
@@ -108,19 +116,36 @@ CreaseLines::Where CreaseLines::locate(const Vec3& p, double tol) const {
   if (segments_.empty()) return where;
   thread_local std::vector<std::uint32_t> near;
   samples_.within(p, reach_ + tol * 2, near);
+  std::uint32_t found = UINT32_MAX;
   for (std::uint32_t sample : near) {
-    const std::uint32_t s = sample_segment_[sample];
-    const Vec3 &a = points_[segments_[s].a], &b = points_[segments_[s].b];
+    const std::uint32_t g = sample_segment_[sample];
+    if (g == found) continue;
+    const Vec3 &a = points_[segments_[g].a], &b = points_[segments_[g].b];
     if ((geom::closest_point_on_segment(p, a, b) - p).sqrnorm() > tol * tol) continue;
     // At an end: that point's kind decides.
-    for (std::uint32_t end : {segments_[s].a, segments_[s].b})
+    for (std::uint32_t end : {segments_[g].a, segments_[g].b})
       if ((points_[end] - p).sqrnorm() <= tol * tol) {
-        if (corner_[end]) return {Kind::Corner, Vec3(0, 0, 0)};
-        return {Kind::Line, through_[end]};
+        if (corner_[end]) return {Kind::Corner, {}, {}};
+        return {Kind::Line, points_[along_[end][0]], points_[along_[end][1]]};
       }
-    where = {Kind::Line, (b - a).normalized()};
+    if (found != UINT32_MAX) return {Kind::Corner, {}, {}};  // two creases pass here
+    found = g;
+    where = {Kind::Line, a, b};
   }
   return where;
+}
+
+Vec3 CreaseLines::slide(const Vec3& p, const Where& where, const Vec3& t) {
+  Vec3 best(0, 0, 0);
+  double gain = 0;
+  for (const Vec3& to : {where.ahead, where.back}) {
+    const Vec3 d = to - p;
+    const double length = d.norm();
+    if (!(length > 0)) continue;
+    const double s = (t | d) / length;
+    if (s > gain) gain = s, best = d * (std::min(s, length) / length);
+  }
+  return best;
 }
 
 }  // namespace remesh

@@ -147,9 +147,19 @@ constexpr int kExploreAfter = 2;
 constexpr double kOrderShare = 0.02;
 constexpr std::size_t kOrderMinVertices = 16384;
 
-/// How near a crease of the reference (crease_lines.h) a vertex lies on it, relative to the bounding
-/// box's diagonal: a vertex projected onto a crease lands on it within the arithmetic's last bits.
-constexpr double kOnCrease = 1e-9;
+/// How near a crease of the reference (crease_lines.h) a vertex lies on it: kOnCrease of the
+/// bounding box's diagonal, or kOnCreaseFar of its largest coordinate when that is more. A vertex
+/// projected onto a crease lands on it within the arithmetic's last bits, and those are bits of its
+/// coordinates: a cylinder 1e8 from the origin lost its rims to a tolerance of the diagonal alone
+/// (99.4 % inside, vertices 0.22 off the surface; at the origin 100 %, on the surface), measured
+/// while the filter moved a crease vertex along a straight line; sliding along the crease it
+/// converges either way (25 iterations with this tolerance, 20 without).
+constexpr double kOnCrease = 1e-9, kOnCreaseFar = 1e-12;
+double crease_tolerance(const TriMesh& mesh) {
+  double far = 0;
+  for (auto v : mesh.vertices()) far = std::max(far, mesh.point(v).max_abs());
+  return std::max(kOnCrease * bounding_box_diagonal(mesh), kOnCreaseFar * far);
+}
 
 /// Rounds of the interval cleanup per iteration (it stops earlier when a round fixes nothing).
 constexpr int kCleanupRounds = 6;
@@ -477,7 +487,7 @@ Result equalize(TriMesh& mesh, const Params& requested, const OnIteration& on_it
   auto reference = std::make_unique<ReferenceSurface>(mesh);
   auto features = std::make_unique<FeatureSnap>(mesh, crease_spacing(params));
   auto creases = std::make_unique<CreaseLines>(mesh);
-  const double on_crease = kOnCrease * bounding_box_diagonal(mesh);
+  const double on_crease = crease_tolerance(mesh);
   setup_timer.stop();
 
   std::vector<IterationStats> history;  // the row of each iteration (plateaued)
@@ -553,12 +563,14 @@ Result equalize(TriMesh& mesh, const Params& requested, const OnIteration& on_it
     // Algorithm 5 then 6: filter and projection, guarded against folds as one move.
     PhaseTimer move_timer(phases.filter);
     const std::vector<Vec3> before = snapshot_points(mesh);
-    // Not in the thesis: until the cleanup starts, vertices on the reference's creases move along
-    // them only (crease_lines.h). The creases are lost, if at all, in the first iterations, while the
-    // mesh is coarse and the filter's moves are long; held in every iteration they cost freedom:
-    // cheese's refinement had 34 crossing face pairs over the five intervals of bench --spread
-    // (0 at [1.2, 1.8]) where it has 7 without the rule and 10 with it held until the cleanup.
-    low_pass_filter(mesh, params.rings, threads, cleanup_from == 0 ? creases.get() : nullptr, on_crease);
+    // Not in the thesis: until the cleanup starts (and in the first half of the iterations, where
+    // it does not run: run_all_iterations, cleanup off), vertices on the reference's creases move
+    // along them only (crease_lines.h). The creases are lost, if at all, in the first iterations,
+    // while the mesh is coarse and the filter's moves are long; held in every iteration they cost
+    // freedom: cheese's refinement had 34 crossing face pairs over the five intervals of bench
+    // --spread (0 at [1.2, 1.8]) where it has 7 without the rule and 10 with it held until the cleanup.
+    const bool hold_creases = cleanup_from == 0 && 2 * i <= params.iterations;
+    low_pass_filter(mesh, params.rings, threads, hold_creases ? creases.get() : nullptr, on_crease);
     if (stop.stop_requested()) {
       move_timer.switch_to(phases.guards);
       undo_folds(mesh, before, threads);

@@ -73,7 +73,7 @@ std::vector<Vec3> low_pass_displacements(const TriMesh& mesh, int rings, unsigne
       const CreaseLines::Where where = creases->locate(mesh.point(v), tol);
       if (where.kind == CreaseLines::Kind::Corner) return;
       if (where.kind == CreaseLines::Kind::Line) {
-        moves[i] = where.direction * (t | where.direction);
+        moves[i] = CreaseLines::slide(mesh.point(v), where, t);
         return;
       }
     }

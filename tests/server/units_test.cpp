@@ -73,7 +73,10 @@ TEST_CASE("options: defaults, command line, environment, errors", "[server][opti
                                                          {"--log-format", "xml"},
                                                          {"--frobnicate", "1"},
                                                          {"stray"},
-                                                         {"--max-iterations", "0"}}) {
+                                                         {"--max-iterations", "0"},
+                                                         {"--heartbeat-seconds", "1e10"},
+                                                         {"--heartbeat-seconds", "nan"},
+                                                         {"--stream-lifetime-seconds", "1e12"}}) {
     auto r = Args(bad).parse();
     CHECK_FALSE(r.options);
     CHECK(r.exit_code == 2);

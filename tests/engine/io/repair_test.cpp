@@ -513,3 +513,21 @@ TEST_CASE("Caps on the boundary are removed and the boundary loops stay") {
   check_repaired(mesh, e);
   CHECK(test::count_boundary_loops(mesh) == 1);
 }
+
+TEST_CASE("A needle's collapse never turns a small face beside it over") {
+  // A needle 1000 long whose short edge (5e-4) has faces 1e-4 across beside it: collapsing the
+  // edge one way turned face (1, 5, 6) over (signed area -2.5e-8 beside positive neighbours).
+  const std::string obj =
+      "v 0 0 0\nv 1000 0 0\nv 5e-4 0 0\nv 500 500 0\nv 3e-4 -1e-4 0\nv 3.5e-4 -2e-4 0\nv 7e-4 -1e-4 0\n"
+      "f 1 2 4\nf 2 1 3\nf 3 1 5\nf 3 5 6\nf 3 6 7\nf 3 7 2\n";
+  const LoadedMesh loaded = read(obj);
+  const TriMesh& mesh = loaded.mesh;
+  REQUIRE(mesh.n_faces() >= 3);
+  for (auto f : mesh.faces()) {
+    Vec3 p[3];
+    int k = 0;
+    for (auto v : mesh.fv_range(f)) p[k++] = mesh.point(v);
+    const double z = ((p[1] - p[0]) % (p[2] - p[0]))[2];  // the mesh lies in z = 0, all faces up
+    CHECK(z > 0);
+  }
+}
