@@ -112,7 +112,7 @@ class Repairer {
     const VertexHandle a = mesh_.from_vertex_handle(h), b = mesh_.to_vertex_handle(h);
     const bool ba = mesh_.is_boundary(a), bb = mesh_.is_boundary(b);
     if (ba != bb ? ba : a.idx() < b.idx()) h = mesh_.opposite_halfedge_handle(h);
-    if (mesh_.is_boundary(mesh_.edge_handle(h)) && !boundary_loop_longer_than_3(h)) return false;
+    if (mesh_.is_boundary(mesh_.edge_handle(h)) && !boundary_loop_longer_than_3(mesh_, h)) return false;
     for (const HalfedgeHandle g : {h, mesh_.opposite_halfedge_handle(h)}) {
       if (!mesh_.is_collapse_ok(g) || turns_a_face(g)) continue;
       const VertexHandle kept = mesh_.to_vertex_handle(g);
@@ -143,14 +143,6 @@ class Repairer {
       if ((n0 | n1) < 0) return true;
     }
     return false;
-  }
-
-  /// Collapsing an edge of a 3-edge boundary loop would close the hole.
-  bool boundary_loop_longer_than_3(HalfedgeHandle h) const {
-    if (!mesh_.is_boundary(h)) h = mesh_.opposite_halfedge_handle(h);
-    HalfedgeHandle g = h;
-    for (int i = 0; i < 3; ++i) g = mesh_.next_halfedge_handle(g);
-    return g != h;
   }
 
   /// A cap's third point lies on e: the two new faces are the neighbour across e split there.

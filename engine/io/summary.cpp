@@ -8,16 +8,9 @@
 #include <limits>
 #include <numeric>
 
+#include "core/union_find.h"
+
 namespace remesh {
-
-namespace {
-
-std::size_t find_root(std::vector<std::size_t>& parent, std::size_t x) {
-  while (parent[x] != x) x = parent[x] = parent[parent[x]];
-  return x;
-}
-
-}  // namespace
 
 MeshSummary summarize(const TriMesh& mesh) {
   MeshSummary s;

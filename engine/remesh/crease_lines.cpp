@@ -7,36 +7,24 @@
 #include <numeric>
 #include <utility>
 
+#include "core/union_find.h"
 #include "remesh/geometry.h"
 
 namespace remesh {
 
 namespace {
 
-/// The median length of the edges (0 with none).
-double median_length(const TriMesh& mesh, const std::vector<OpenMesh::EdgeHandle>& edges) {
-  std::vector<double> lengths;
-  for (auto e : edges) lengths.push_back(mesh.calc_edge_length(e));
-  if (lengths.empty()) return 0;
-  std::nth_element(lengths.begin(), lengths.begin() + static_cast<long>(lengths.size() / 2), lengths.end());
-  return lengths[lengths.size() / 2];
-}
-
-std::uint32_t root(std::vector<std::uint32_t>& parent, std::uint32_t x) {
-  while (parent[x] != x) x = parent[x] = parent[parent[x]];
-  return x;
-}
-
 /// The edges sharper than kCreaseAngle, in connected groups of at least kMinCreaseEdges.
 std::vector<OpenMesh::EdgeHandle> crease_edges(const TriMesh& mesh) {
   const double limit = std::cos(kCreaseAngle);
+  const std::vector<Vec3> normals = geom::face_normals(mesh, 1);  // each face's once, not per edge
   std::vector<OpenMesh::EdgeHandle> sharp;
   for (auto e : mesh.edges()) {
     if (mesh.status(e).deleted() || mesh.is_boundary(e)) continue;
-    const Vec3 a = geom::face_normal(mesh, mesh.face_handle(mesh.halfedge_handle(e, 0)));
-    const Vec3 b = geom::face_normal(mesh, mesh.face_handle(mesh.halfedge_handle(e, 1)));
-    const double na = a.norm(), nb = b.norm();
-    if (na > 0 && nb > 0 && (a | b) < limit * na * nb) sharp.push_back(e);
+    const Vec3& a = normals[mesh.face_handle(mesh.halfedge_handle(e, 0)).idx()];
+    const Vec3& b = normals[mesh.face_handle(mesh.halfedge_handle(e, 1)).idx()];
+    // A degenerate face has no direction to disagree with (as feature_snap.cpp's creases).
+    if (a.sqrnorm() > 0 && b.sqrnorm() > 0 && !geom::normals_agree(a, b, limit)) sharp.push_back(e);
   }
   std::vector<std::uint32_t> parent(mesh.n_vertices());
   std::iota(parent.begin(), parent.end(), 0u);
@@ -47,13 +35,13 @@ std::vector<OpenMesh::EdgeHandle> crease_edges(const TriMesh& mesh) {
   };
   for (auto e : sharp) {
     const auto [a, b] = ends(e);
-    parent[root(parent, a)] = root(parent, b);
+    parent[find_root(parent, a)] = find_root(parent, b);
   }
   std::vector<std::uint32_t> count(mesh.n_vertices(), 0);
-  for (auto e : sharp) ++count[root(parent, ends(e).first)];
+  for (auto e : sharp) ++count[find_root(parent, ends(e).first)];
   std::vector<OpenMesh::EdgeHandle> out;
   for (auto e : sharp)
-    if (count[root(parent, ends(e).first)] >= kMinCreaseEdges) out.push_back(e);
+    if (count[find_root(parent, ends(e).first)] >= kMinCreaseEdges) out.push_back(e);
   return out;
 }
 
@@ -79,10 +67,15 @@ CreaseLines::CreaseLines(const TriMesh& reference, const std::vector<OpenMesh::E
   // looks at a few samples even where some creases are hundreds of times longer than the rest
   // (cheese), but at least 1/16 of the mean, so that a few long creases beside many short ones
   // cannot make the samples many (a 48-face prism 1e7 long, its caps' edges cut in 4: 4.5 GB).
-  double total = 0;
-  for (const Segment& g : segments_) total += (points_[g.a] - points_[g.b]).norm();
-  const double step =
-      segments_.empty() ? 0 : std::max(median_length(reference, edges), total / (16.0 * static_cast<double>(segments_.size())));
+  std::vector<double> lengths;
+  for (const Segment& g : segments_) lengths.push_back((points_[g.a] - points_[g.b]).norm());
+  double step = 0;
+  if (!lengths.empty()) {
+    const double total = std::accumulate(lengths.begin(), lengths.end(), 0.0);
+    const auto middle = lengths.begin() + static_cast<long>(lengths.size() / 2);
+    std::nth_element(lengths.begin(), middle, lengths.end());
+    step = std::max(*middle, total / (16.0 * static_cast<double>(lengths.size())));
+  }
   std::vector<Vec3> samples;
   for (std::uint32_t g = 0; g < segments_.size(); ++g) {
     const Vec3 &pa = points_[segments_[g].a], &pb = points_[segments_[g].b];

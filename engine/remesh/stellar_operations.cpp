@@ -58,14 +58,6 @@ bool split_point_ok(const TriMesh& mesh, EdgeHandle e, const Vec3& p) {
   return true;
 }
 
-/// Is h's boundary loop longer than 3 edges? (Collapsing an edge of a 3-edge hole would close it.)
-bool boundary_loop_longer_than_3(const TriMesh& mesh, HalfedgeHandle h) {
-  if (!mesh.is_boundary(h)) h = mesh.opposite_halfedge_handle(h);
-  HalfedgeHandle g = h;
-  for (int i = 0; i < 3; ++i) g = mesh.next_halfedge_handle(g);
-  return g != h;
-}
-
 }  // namespace
 
 VertexHandle split_edge(TriMesh& mesh, EdgeHandle e, double target) {

@@ -10,6 +10,7 @@
 #include <utility>
 #include <vector>
 
+#include "core/union_find.h"
 #include "remesh/geometry.h"
 #include "remesh/point_index.h"
 #include "remesh/projection.h"
@@ -72,10 +73,7 @@ std::vector<std::vector<VertexHandle>> tangles(const TriMesh& mesh, const Pairs&
   for (std::size_t i = 0; i < vertices.size(); ++i) slot[vertices[i].idx()] = i;
   std::vector<std::size_t> parent(vertices.size());
   std::iota(parent.begin(), parent.end(), 0);
-  auto root = [&](std::size_t i) {
-    while (parent[i] != i) i = parent[i] = parent[parent[i]];
-    return i;
-  };
+  auto root = [&](std::size_t i) { return find_root(parent, i); };
   for (const auto& [f, g] : pairs)
     for (unsigned face : {f, g}) {
       std::size_t first = SIZE_MAX;
