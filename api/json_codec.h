@@ -4,7 +4,7 @@
 /// string map (query string, command line). Shared by remeshd and the `remesh` CLI.
 ///
 /// Parameter names (API, CLI, JSON): emin, emax, iterations, rings, relax_every, flip_factor,
-/// run_all_iterations, protect_tips; `weld` is a read option carried alongside (ParsedParams::weld).
+/// run_all_iterations, protect_tips, keep_creases; `weld` is a read option carried alongside (ParsedParams::weld).
 
 #include <map>
 #include <string>
@@ -34,7 +34,8 @@ void to_json(nlohmann::json& j, const IterationStats& s);
 /// Reads a row written by to_json; missing fields stay 0. Throws nlohmann::json::exception on
 /// wrong types.
 void from_json(const nlohmann::json& j, IterationStats& s);
-/// {emin, emax, iterations, rings, relax_every, flip_factor, run_all_iterations, protect_tips}
+/// {emin, emax, iterations, rings, relax_every, flip_factor, run_all_iterations, protect_tips,
+/// keep_creases}
 void to_json(nlohmann::json& j, const Params& p);
 /// {field, message}
 void to_json(nlohmann::json& j, const FieldError& e);

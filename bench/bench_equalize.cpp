@@ -2,8 +2,8 @@
 /// Reproduces the thesis' Table 4.2 setup on any mesh, and compares with CGAL.
 ///
 ///   bench_equalize MESH... [--setup refine|simplify|both|coarsen|all] [--iterations N] [--no-cgal]
-///                  [--threads T] [--samples N] [--rows-every K] [--no-cleanup] [--keep DIR] [--spread]
-///                  [--cgal-matched]
+///                  [--threads T] [--samples N] [--rows-every K] [--no-cleanup] [--keep-creases] [--keep DIR]
+///                  [--spread] [--cgal-matched]
 ///
 /// refine:   scale the mesh so its mean edge is 2.25, remesh to [1.2, 1.8] (Table 4.2)
 /// simplify: scale to mean edge 0.75, remesh to [1.2, 1.8] (Table 4.1)
@@ -46,7 +46,7 @@ namespace {
 
 struct Options {
   std::vector<std::string> meshes;
-  bool refine = true, simplify = false, coarsen = false, cgal = true, cleanup = true;
+  bool refine = true, simplify = false, coarsen = false, cgal = true, cleanup = true, keep_creases = false;
   int iterations = 100, rows_every = 5;
   unsigned threads = 0;
   std::size_t samples = 400000;
@@ -59,7 +59,7 @@ constexpr double kEmin = 1.2, kEmax = 1.8;
 [[noreturn]] void usage(const std::string& error) {
   std::fprintf(stderr,
                "bench_equalize: %s\nusage: bench_equalize MESH... [--setup refine|simplify|both|coarsen|all] [--iterations N] "
-               "[--no-cgal] [--threads T] [--samples N] [--rows-every K] [--no-cleanup] [--keep DIR] [--spread] "
+               "[--no-cgal] [--threads T] [--samples N] [--rows-every K] [--no-cleanup] [--keep-creases] [--keep DIR] [--spread] "
                "[--cgal-matched]\n",
                error.c_str());
   std::exit(1);
@@ -86,6 +86,7 @@ Options parse(int argc, char** argv) {
       else if (a == "--rows-every") o.rows_every = std::max(1, std::stoi(value()));
       else if (a == "--no-cgal") o.cgal = false;
       else if (a == "--no-cleanup") o.cleanup = false;
+      else if (a == "--keep-creases") o.keep_creases = true;
       else if (a == "--keep") o.keep_dir = value();
       else if (a == "--spread") o.spread = true;
       else if (a == "--cgal-matched") o.cgal_matched = true;
@@ -216,6 +217,7 @@ ChildResult run_ours(const std::string& scaled, const std::string& out_file, dou
     p.iterations = o.iterations;
     p.threads = o.threads;
     p.cleanup = o.cleanup;
+    p.keep_creases = o.keep_creases;
     IterationStats last;
     const Result r = equalize(mesh, p, [&](const IterationStats& s) {
       if (rows && (s.iteration % o.rows_every == 0 || s.iteration == 1)) print_row(s);
@@ -328,7 +330,8 @@ void run_setup(const std::string& path, const char* setup, double mean_edge, con
     bench::write_off(mesh, scaled);
     std::printf("\n== %s, setup %s: scaled by %.6g to mean edge %.2f; target [%.1f, %.1f], k=2, pr=0, f=0.5, up to %d "
                 "iterations%s; input V %zu F %zu (euler %ld, boundary loops %zu, components %zu)\n",
-                path.c_str(), setup, factor, mean_edge, kEmin, kEmax, o.iterations, o.cleanup ? "" : ", no cleanup",
+                path.c_str(), setup, factor, mean_edge, kEmin, kEmax, o.iterations,
+                o.cleanup ? (o.keep_creases ? ", creases kept" : "") : ", no cleanup",
                 mesh.n_vertices(), mesh.n_faces(), topo_in.euler, topo_in.boundary_loops, topo_in.components);
   }
   std::printf("  it  vertices     edges    mean     dev regular%%   small     big  inside%%  splits  collap   flips    "

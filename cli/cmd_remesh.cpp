@@ -31,6 +31,7 @@ const std::vector<OptionSpec> kSpec = {
     {"flip-factor", "F", "a flip may lower the min angle to F times its old value, 0..1 (default 0.5)"},
     {"all-iterations", "", "run all N iterations instead of stopping early (converged or stalled)"},
     {"protect-tips", "", "never move tips (ears, horns, spikes) to mend edges: closer to the input there, more edges outside"},
+    {"keep-creases", "", "keep the input's sharp edges (over 75 degrees) exactly, as CAD models need; more edges may stay outside"},
     {"dual", "DUAL_OUT", "also write the trivalent dual of the result, projected onto IN"},
     {"stats", "FILE", "write the per-iteration statistics to FILE.csv or FILE.json"},
     {"threads", "T", "worker threads; 0 = all cores (default 0; results do not depend on it)"},
@@ -75,6 +76,7 @@ Job parse_job(const std::vector<std::string>& args) {
   }
   p.run_all_iterations = a.has("all-iterations");
   p.protect_tips = a.has("protect-tips");
+  p.keep_creases = a.has("keep-creases");
   job.read.weld = a.has("weld");
   job.quiet = a.has("quiet");
   job.dual_out = a.get("dual");

@@ -4,6 +4,7 @@
 #include <climits>
 #include <cstdint>
 #include <cmath>
+#include <limits>
 #include <numeric>
 #include <utility>
 
@@ -104,17 +105,25 @@ CreaseLines::CreaseLines(const TriMesh& reference, const std::vector<OpenMesh::E
   }
 }
 
+const std::vector<std::uint32_t>& CreaseLines::segments_near(const Vec3& p, double tol) const {
+  thread_local std::vector<std::uint32_t> near, segments;
+  samples_.within(p, reach_ + tol * 2, near);
+  segments.clear();
+  for (std::uint32_t sample : near) {
+    const std::uint32_t g = sample_segment_[sample];
+    if (!segments.empty() && segments.back() == g) continue;  // a segment's samples are consecutive
+    const Vec3 &a = points_[segments_[g].a], &b = points_[segments_[g].b];
+    if ((geom::closest_point_on_segment(p, a, b) - p).sqrnorm() <= tol * tol) segments.push_back(g);
+  }
+  return segments;
+}
+
 CreaseLines::Where CreaseLines::locate(const Vec3& p, double tol) const {
   Where where;
   if (segments_.empty()) return where;
-  thread_local std::vector<std::uint32_t> near;
-  samples_.within(p, reach_ + tol * 2, near);
   std::uint32_t found = UINT32_MAX;
-  for (std::uint32_t sample : near) {
-    const std::uint32_t g = sample_segment_[sample];
-    if (g == found) continue;
+  for (std::uint32_t g : segments_near(p, tol)) {
     const Vec3 &a = points_[segments_[g].a], &b = points_[segments_[g].b];
-    if ((geom::closest_point_on_segment(p, a, b) - p).sqrnorm() > tol * tol) continue;
     // At an end: that point's kind decides.
     for (std::uint32_t end : {segments_[g].a, segments_[g].b})
       if ((points_[end] - p).sqrnorm() <= tol * tol) {
@@ -139,6 +148,66 @@ Vec3 CreaseLines::slide(const Vec3& p, const Where& where, const Vec3& t) {
     if (s > gain) gain = s, best = d * (std::min(s, length) / length);
   }
   return best;
+}
+
+bool CreaseLines::joined(const Vec3& a, const Vec3& b, double tol, double max_arc,
+                         std::vector<std::array<Vec3, 2>>* path) const {
+  if (segments_.empty()) return false;
+  auto near_segment = [&](const Vec3& p, const Vec3& s, const Vec3& t) {
+    return (geom::closest_point_on_segment(p, s, t) - p).sqrnorm() <= tol * tol;
+  };
+  for (std::uint32_t g : segments_near(a, tol)) {
+    const Vec3 &s = points_[segments_[g].a], &t = points_[segments_[g].b];
+    const std::size_t kept = path ? path->size() : 0;
+    if (path) path->push_back({s, t});
+    if (near_segment(b, s, t)) return (b - a).norm() <= max_arc;
+    // Walk from each end of a's segment along the crease, to b or a corner or max_arc.
+    for (const auto& [from, to] : {std::pair{segments_[g].b, segments_[g].a}, std::pair{segments_[g].a, segments_[g].b}}) {
+      std::uint32_t prev = from, at = to;
+      double arc = (points_[at] - a).norm();
+      const std::size_t start = path ? path->size() : 0;
+      while (arc <= max_arc) {
+        if ((points_[at] - b).sqrnorm() <= tol * tol) return true;  // b at this point (a corner too)
+        if (corner_[at]) break;
+        const std::uint32_t next = along_[at][0] == prev ? along_[at][1] : along_[at][0];
+        if (path) path->push_back({points_[at], points_[next]});
+        if (near_segment(b, points_[at], points_[next])) return arc + (b - points_[at]).norm() <= max_arc;
+        arc += (points_[next] - points_[at]).norm();
+        prev = at, at = next;
+      }
+      if (path) path->resize(start);
+    }
+    if (path) path->resize(kept);
+  }
+  return false;
+}
+
+bool CreaseGuard::along(const Vec3& a, const Vec3& b) const {
+  if (empty() || !on(a) || !on(b)) return false;
+  return lines_->joined(a, b, tol_, kArcShare * (b - a).norm() + tol_);
+}
+
+Vec3 CreaseGuard::onto(const Vec3& p, const Vec3& a, const Vec3& b) const {
+  thread_local std::vector<std::array<Vec3, 2>> path;
+  path.clear();
+  if (!lines_->joined(a, b, tol_, kArcShare * (b - a).norm() + tol_, &path)) return p;
+  Vec3 best = p;
+  double nearest = std::numeric_limits<double>::infinity();
+  for (const auto& [s, t] : path) {
+    const Vec3 q = geom::closest_point_on_segment(p, s, t);
+    const double d = (q - p).sqrnorm();
+    if (d < nearest) nearest = d, best = q;
+  }
+  return best;
+}
+
+Vec3 CreaseGuard::constrain(const Vec3& p, const CreaseLines::Where& where, const Vec3& x) {
+  switch (where.kind) {
+    case CreaseLines::Kind::None: return x;
+    case CreaseLines::Kind::Corner: return p;
+    case CreaseLines::Kind::Line: break;
+  }
+  return p + CreaseLines::slide(p, where, x - p);
 }
 
 }  // namespace remesh

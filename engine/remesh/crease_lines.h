@@ -65,10 +65,18 @@ class CreaseLines {
   /// the side (towards `ahead` or `back`) t points to more, no farther than that point.
   static Vec3 slide(const Vec3& p, const Where& where, const Vec3& t);
 
+  /// Does one crease run from a to b (both within `tol` of it), its length between them at most
+  /// `max_arc`, passing no corner (it may end at one: a or b)? With `path`, the segments it runs
+  /// along are appended to it, as pairs of points.
+  bool joined(const Vec3& a, const Vec3& b, double tol, double max_arc,
+              std::vector<std::array<Vec3, 2>>* path = nullptr) const;
+
  private:
   struct Segment {
     std::uint32_t a, b;  ///< indices into points_
   };
+  /// The segments passing within tol of p, each once (a per-thread buffer, valid until the next call).
+  const std::vector<std::uint32_t>& segments_near(const Vec3& p, double tol) const;
   std::vector<Vec3> points_;            ///< the reference's vertices
   std::vector<Segment> segments_;
   std::vector<std::uint8_t> corner_;    ///< by point: a corner of the crease network
@@ -77,6 +85,43 @@ class CreaseLines {
   PointIndex samples_;                  ///< points along the segments (crease_lines.cpp)
   std::vector<std::uint32_t> sample_segment_;  ///< by sample: its segment
   double reach_ = 0;                    ///< half the samples' largest spacing
+};
+
+/// Not in the thesis: the rule every step of a run follows so that the reference's creases stay in
+/// the remeshed surface exactly, as its boundary curves do. Which vertices and edges are on a
+/// crease is read from their positions (no mark to carry through the edits, renumberings and
+/// snapshots): a vertex whose point lies on a crease within `tol` is on it (a Line vertex, or a
+/// Corner), and an edge runs along a crease when one crease joins its ends, no longer than
+/// kArcShare times the edge between them and through no corner (CreaseLines::joined: the chord of
+/// a crease, not an edge across to a crease beside it, as the rims of a wall between two holes).
+/// - a vertex on a crease moves along it only; a corner does not move (filter, cleanup);
+/// - an edge along a crease is not flipped; its split point and its collapse point are put on the
+///   crease;
+/// - an edge with one end on a crease (not along it) collapses onto that end; one with both ends on
+///   creases (not along one) is not collapsed, nor one along a crease between two corners.
+/// Measured in equalize.cpp (kept_creases).
+class CreaseGuard {
+ public:
+  /// A chord over an arc of 90 degrees is 0.90 as long as the arc.
+  static constexpr double kArcShare = 1.5;
+
+  CreaseGuard(const CreaseLines& lines, double tol) : lines_(&lines), tol_(tol) {}
+
+  bool empty() const { return lines_->empty(); }
+  CreaseLines::Where locate(const Vec3& p) const { return lines_->locate(p, tol_); }
+  bool on(const Vec3& p) const { return !empty() && locate(p).kind != CreaseLines::Kind::None; }
+  /// Does the edge (a, b) run along a crease? (See the class comment.)
+  bool along(const Vec3& a, const Vec3& b) const;
+  /// The point closest to p of the crease that joins a and b (the ends of an edge along it; p a
+  /// point of the edge); p itself when none joins them.
+  Vec3 onto(const Vec3& p, const Vec3& a, const Vec3& b) const;
+  /// Where a vertex at p (on a crease: `where`) ends up when a step would move it to x: x off the
+  /// creases, p at a corner, along the crease towards x on a Line (slide).
+  static Vec3 constrain(const Vec3& p, const CreaseLines::Where& where, const Vec3& x);
+
+ private:
+  const CreaseLines* lines_;
+  double tol_;
 };
 
 }  // namespace remesh

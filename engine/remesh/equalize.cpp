@@ -233,8 +233,8 @@ std::size_t final_patch_budget(const TriMesh& mesh) { return std::max<std::size_
 /// budget; `boundary_only` before the full cleanup starts) or, with `final`, the final cleanup's
 /// (kFinalCleanupRounds, final_patch_budget).
 CleanupCounts run_cleanup(TriMesh& mesh, const ReferenceSurface& reference, const Params& params,
-                          std::vector<NeighbourCache>& caches, bool final, bool boundary_only = false,
-                          std::stop_token stop = {}) {
+                          std::vector<NeighbourCache>& caches, const CreaseGuard* creases, bool final,
+                          bool boundary_only = false, std::stop_token stop = {}) {
   CleanupOptions options;
   options.rounds = final ? kFinalCleanupRounds : kCleanupRounds;
   if (final) options.patch_budget = final_patch_budget(mesh);
@@ -242,6 +242,7 @@ CleanupCounts run_cleanup(TriMesh& mesh, const ReferenceSurface& reference, cons
   options.caches = &caches;
   options.protect_tips = params.protect_tips;
   options.stop = std::move(stop);
+  options.creases = creases;
   return interval_cleanup(mesh, reference, params.e_min, params.e_max, params.flip_factor, options);
 }
 
@@ -296,7 +297,8 @@ std::vector<CrossingKey> crossing_keys(const TriMesh& mesh, const std::vector<st
 }
 
 void untangle_and_mend(TriMesh& mesh, const ReferenceSurface& reference, const Params& params,
-                       std::vector<NeighbourCache>& caches, IterationStats& row, PhaseSeconds& phases) {
+                       std::vector<NeighbourCache>& caches, const CreaseGuard* creases, IterationStats& row,
+                       PhaseSeconds& phases) {
   // The row describes the mesh before the feature snap, which takes no edge out of the interval.
   const std::size_t outside_before = row.small + row.big;
   for (int round = 1; round <= kUntangleRounds; ++round) {
@@ -313,7 +315,7 @@ void untangle_and_mend(TriMesh& mesh, const ReferenceSurface& reference, const P
     if (now.small + now.big <= outside_before) return;
     const std::vector<CrossingKey> left = crossing_keys(mesh, u.left);
     timer.switch_to(phases.cleanup);
-    const CleanupCounts c = run_cleanup(mesh, reference, params, caches, /*final=*/true);
+    const CleanupCounts c = run_cleanup(mesh, reference, params, caches, creases, /*final=*/true);
     timer.switch_to(phases.untangle);
     count_cleanup(row, c);
     // Again only if the cleanup made faces cross that did not before (the pairs it left alone
@@ -488,6 +490,11 @@ Result equalize(TriMesh& mesh, const Params& requested, const OnIteration& on_it
   auto features = std::make_unique<FeatureSnap>(mesh, crease_spacing(params));
   auto creases = std::make_unique<CreaseLines>(mesh);
   const double on_crease = crease_tolerance(mesh);
+  // With Params::keep_creases, the rule that keeps them (crease_lines.h); none without creases.
+  auto guard_of = [&](const CreaseLines& lines) {
+    return !params.keep_creases || lines.empty() ? nullptr : std::make_unique<CreaseGuard>(lines, on_crease);
+  };
+  std::unique_ptr<CreaseGuard> guard = guard_of(*creases);
   setup_timer.stop();
 
   std::vector<IterationStats> history;  // the row of each iteration (plateaued)
@@ -521,6 +528,7 @@ Result equalize(TriMesh& mesh, const Params& requested, const OnIteration& on_it
       reference = std::make_unique<ReferenceSurface>(mesh);
       features = std::make_unique<FeatureSnap>(mesh, crease_spacing(params));
       creases = std::make_unique<CreaseLines>(mesh);
+      guard = guard_of(*creases);
     }
 
     // Algorithms 2 and 3: stellar operations on the priority list.
@@ -529,7 +537,7 @@ Result equalize(TriMesh& mesh, const Params& requested, const OnIteration& on_it
       const double m_i = std::min(2.0 * mean_edge_length(mesh, threads), m);
       const double sigma_i = band_at(sigma, m_i);
       const std::vector<unsigned> list = make_priority_list(mesh, m_i, sigma_i, threads);
-      const StellarCounts stellar = stellar_operations(mesh, list, m_i, sigma_i);
+      const StellarCounts stellar = stellar_operations(mesh, list, m_i, sigma_i, guard.get());
       collect_garbage(mesh);
       renumbered_since += stellar.splits + stellar.collapses;
       if (mesh.n_vertices() >= kOrderMinVertices &&
@@ -548,10 +556,10 @@ Result equalize(TriMesh& mesh, const Params& requested, const OnIteration& on_it
     // Algorithm 4: valence-improving flips.
     {
       const PhaseTimer timer(phases.flips);
-      counters.flips = valence_flips(mesh, params.flip_factor, kFlipSweeps, threads);
+      counters.flips = valence_flips(mesh, params.flip_factor, kFlipSweeps, threads, guard.get());
       // Not in the thesis: the look-ahead flips that let 5-7 pairs cancel (regularize.h).
       if (params.cleanup) {
-        const RegularizeCounts r = regularize(mesh, params.flip_factor, kRegularizeSweeps, threads);
+        const RegularizeCounts r = regularize(mesh, params.flip_factor, kRegularizeSweeps, threads, guard.get());
         counters.flips += r.single + 2 * r.pairs;
       }
     }
@@ -569,7 +577,7 @@ Result equalize(TriMesh& mesh, const Params& requested, const OnIteration& on_it
     // while the mesh is coarse and the filter's moves are long; held in every iteration they cost
     // freedom: cheese's refinement had 34 crossing face pairs over the five intervals of bench
     // --spread (0 at [1.2, 1.8]) where it has 7 without the rule and 10 with it held until the cleanup.
-    const bool hold_creases = cleanup_from == 0 && 2 * i <= params.iterations;
+    const bool hold_creases = guard || (cleanup_from == 0 && 2 * i <= params.iterations);
     low_pass_filter(mesh, params.rings, threads, hold_creases ? creases.get() : nullptr, on_crease);
     if (stop.stop_requested()) {
       move_timer.switch_to(phases.guards);
@@ -586,7 +594,8 @@ Result equalize(TriMesh& mesh, const Params& requested, const OnIteration& on_it
     // the run keeps reaching new lows of edges outside (kExploreAfter) and has not converged.
     if (params.cleanup && cleanup_from > 0 && i - cleanup_from >= kSteadyAfter && !best &&
         i - 1 - fewest_at < kExploreAfter)
-      while (undo_interval_breaks(mesh, before, params.e_min, params.e_max) > 0 && undo_folds(mesh, before, threads) > 0) {
+      while (undo_interval_breaks(mesh, before, params.e_min, params.e_max, 3, reference.get()) > 0 &&
+             undo_folds(mesh, before, threads) > 0) {
       }
     move_timer.stop();
 
@@ -605,7 +614,7 @@ Result equalize(TriMesh& mesh, const Params& requested, const OnIteration& on_it
       const bool full = last || cleanup_started;
       if (full || reference->has_boundary()) {
         const PhaseTimer timer(phases.cleanup);
-        const CleanupCounts c = run_cleanup(mesh, *reference, params, neighbour_caches, /*final=*/false,
+        const CleanupCounts c = run_cleanup(mesh, *reference, params, neighbour_caches, guard.get(), /*final=*/false,
                                             /*boundary_only=*/!full, stop);
         count_cleanup(counters, c);
         renumbered_since += c.splits + c.collapses;
@@ -664,7 +673,8 @@ Result equalize(TriMesh& mesh, const Params& requested, const OnIteration& on_it
         if (!stop.stop_requested()) {
           PhaseTimer timer(phases.cleanup);
           const CleanupCounts c =
-              run_cleanup(mesh, *reference, params, neighbour_caches, /*final=*/true, /*boundary_only=*/false, stop);
+              run_cleanup(mesh, *reference, params, neighbour_caches, guard.get(), /*final=*/true,
+                          /*boundary_only=*/false, stop);
           timer.stop();
           if (fixes(c) > 0) {
             count_cleanup(row, c);
@@ -690,11 +700,11 @@ Result equalize(TriMesh& mesh, const Params& requested, const OnIteration& on_it
       // its 119 MB there).
       std::vector<NeighbourCache>().swap(neighbour_caches);
       PhaseTimer timer(phases.snap);
-      const std::size_t snapped = features->apply(mesh, *reference, params.e_min, params.e_max, threads);
+      const std::size_t snapped = features->apply(mesh, *reference, params.e_min, params.e_max, threads, guard.get());
       timer.stop();
       const std::size_t fixes_before = row.cleanup_fixes;
       row.cleanup_fixes += snapped;
-      untangle_and_mend(mesh, *reference, params, neighbour_caches, row, phases);
+      untangle_and_mend(mesh, *reference, params, neighbour_caches, guard.get(), row, phases);
       if (row.cleanup_fixes != fixes_before) row = measured_row(mesh, params, row);
     }
     // The outcome of a run that stopped early describes the mesh returned, which this row does: the

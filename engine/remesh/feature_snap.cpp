@@ -93,11 +93,11 @@ FeatureSnap::FeatureSnap(const TriMesh& reference, double crease_spacing)
 std::size_t FeatureSnap::budget_for(std::size_t vertices) { return std::max(kSnapBudgetMin, vertices / kSnapBudgetPer); }
 
 std::size_t FeatureSnap::apply(TriMesh& mesh, const ReferenceSurface& reference, double e_min, double e_max,
-                               unsigned threads) const {
+                               unsigned threads, const CreaseGuard* creases) const {
   std::size_t budget = budget_for(mesh.n_vertices()), moved = 0;
   Gaps gaps;
   for (int i = 0; i < kSnapPasses; ++i) {
-    const std::size_t n = pass(mesh, reference, e_min, e_max, threads, budget, gaps);
+    const std::size_t n = pass(mesh, reference, e_min, e_max, threads, budget, gaps, creases);
     moved += n;
     if (n == 0) break;
   }
@@ -105,13 +105,13 @@ std::size_t FeatureSnap::apply(TriMesh& mesh, const ReferenceSurface& reference,
 }
 
 std::size_t FeatureSnap::pass(TriMesh& mesh, const ReferenceSurface& reference, double e_min, double e_max,
-                              unsigned threads, std::size_t& budget) const {
+                              unsigned threads, std::size_t& budget, const CreaseGuard* creases) const {
   Gaps gaps;
-  return pass(mesh, reference, e_min, e_max, threads, budget, gaps);
+  return pass(mesh, reference, e_min, e_max, threads, budget, gaps, creases);
 }
 
 std::size_t FeatureSnap::pass(TriMesh& mesh, const ReferenceSurface& reference, double e_min, double e_max,
-                              unsigned threads, std::size_t& budget, Gaps& gaps) const {
+                              unsigned threads, std::size_t& budget, Gaps& gaps, const CreaseGuard* creases) const {
   const std::vector<Vec3>& points = points_.points();
   if (points.empty() || mesh.n_faces() == 0 || budget == 0) return 0;
   const ReferenceSurface current(mesh);
@@ -149,7 +149,7 @@ std::size_t FeatureSnap::pass(TriMesh& mesh, const ReferenceSurface& reference, 
     }
   }
   const std::vector<Vec3> before = snapshot_points(mesh);
-  const std::size_t kept = snap_to_features(mesh, reference, e_min, e_max, moves, points_, budget);
+  const std::size_t kept = snap_to_features(mesh, reference, e_min, e_max, moves, points_, budget, creases);
   // What moved, for the next pass (a refused move puts its patch back exactly).
   double longest = 0;
   for (auto v : mesh.vertices()) {

@@ -39,6 +39,7 @@
 #include <vector>
 
 #include "core/mesh.h"
+#include "remesh/crease_lines.h"
 #include "remesh/point_index.h"
 #include "remesh/reference_surface.h"
 
@@ -52,13 +53,14 @@ class FeatureSnap {
 
   /// The snap of a run's last iteration: up to kSnapPasses passes within the budget. Precondition:
   /// `mesh` has no deleted elements. Returns the number of moves kept. Deterministic (the order is
-  /// fixed; the distance queries run in parallel).
+  /// fixed; the distance queries run in parallel). With `creases`, no vertex leaves a crease
+  /// (snap_to_features).
   std::size_t apply(TriMesh& mesh, const ReferenceSurface& reference, double e_min, double e_max,
-                    unsigned threads) const;
+                    unsigned threads, const CreaseGuard* creases = nullptr) const;
 
   /// One pass; each patch relaxation takes one from `budget`. Returns the number of moves kept.
   std::size_t pass(TriMesh& mesh, const ReferenceSurface& reference, double e_min, double e_max, unsigned threads,
-                   std::size_t& budget) const;
+                   std::size_t& budget, const CreaseGuard* creases = nullptr) const;
 
   /// apply()'s budget of patch relaxations for a mesh of `vertices` vertices.
   static std::size_t budget_for(std::size_t vertices);
@@ -68,7 +70,7 @@ class FeatureSnap {
  private:
   struct Gaps;
   std::size_t pass(TriMesh& mesh, const ReferenceSurface& reference, double e_min, double e_max, unsigned threads,
-                   std::size_t& budget, Gaps& gaps) const;
+                   std::size_t& budget, Gaps& gaps, const CreaseGuard* creases) const;
 
   PointIndex points_;
 };

@@ -83,7 +83,7 @@ std::size_t undo_folds(TriMesh& mesh, const std::vector<Vec3>& before, unsigned 
 }
 
 std::size_t undo_interval_breaks(TriMesh& mesh, const std::vector<Vec3>& before, double e_min, double e_max,
-                                 int halvings) {
+                                 int halvings, const ReferenceSurface* reference) {
   auto inside = [&](double length) { return length >= e_min && length <= e_max; };
   auto broken = [&](OpenMesh::EdgeHandle e) {
     const auto h = mesh.halfedge_handle(e, 0);
@@ -103,7 +103,12 @@ std::size_t undo_interval_breaks(TriMesh& mesh, const std::vector<Vec3>& before,
       for (auto v : {mesh.from_vertex_handle(h), mesh.to_vertex_handle(h)}) {
         const Vec3& was = before[v.idx()];
         if (mesh.point(v) == was) continue;
-        mesh.point(v) = retreats[v.idx()]++ < halvings ? (mesh.point(v) + was) * 0.5 : was;
+        if (retreats[v.idx()]++ < halvings) {
+          const Vec3 half = (mesh.point(v) + was) * 0.5;
+          mesh.point(v) = reference ? reference->closest_point(half, geom::vertex_normal(mesh, v)) : half;
+        } else {
+          mesh.point(v) = was;
+        }
         moved.push_back(v);
         ++moves;
       }

@@ -178,6 +178,7 @@ class Cleanup {
   bool stop_requested() const { return stop_.stop_requested(); }
   void set_remember_failures(bool on) { remember_failures_ = on; }
   void set_protect_tips(bool on) { protect_tips_ = on; }
+  void set_creases(const CreaseGuard* creases) { creases_ = creases && !creases->empty() ? creases : nullptr; }
 
   NeighbourCache* cache_of(VertexHandle v) {
     return caches_ && static_cast<std::size_t>(v.idx()) < caches_->size() ? &(*caches_)[v.idx()] : nullptr;
@@ -289,7 +290,7 @@ class Cleanup {
     const VertexHandle v2 = mesh_.to_vertex_handle(mesh_.next_halfedge_handle(h0));
     const VertexHandle v3 = mesh_.to_vertex_handle(mesh_.next_halfedge_handle(h1));
     if (!inside((mesh_.point(v2) - mesh_.point(v3)).norm())) return false;
-    if (!flip_is_safe(mesh_, e, f_)) return false;
+    if (!flip_is_safe(mesh_, e, f_, nullptr, false, creases_)) return false;
     mesh_.flip(e);
     ++clock_;
     const HalfedgeHandle h = mesh_.halfedge_handle(e, 0);
@@ -337,17 +338,19 @@ class Cleanup {
 
   bool collapse_at(EdgeHandle e, double plan_limit, bool free_placement) {
     CollapsePlan plan;
-    if (!plan_collapse(mesh_, e, target(), plan_limit, plan, /*keep_tips=*/protect_tips_)) return false;
+    if (!plan_collapse(mesh_, e, target(), plan_limit, plan, /*keep_tips=*/protect_tips_, creases_)) return false;
     const VertexHandle kept = mesh_.to_vertex_handle(plan.halfedge);
     const VertexHandle removed = mesh_.from_vertex_handle(plan.halfedge);
     const bool on_boundary = mesh_.is_boundary(kept) || mesh_.is_boundary(removed);
+    // A collapse at a crease: plan_collapse put the point on it or kept the crease end.
+    const bool on_crease = creases_ && (creases_->on(mesh_.point(kept)) || creases_->on(mesh_.point(removed)));
     // A vertex plan_collapse keeps in place (a boundary end, a protected tip) stays there; a
     // boundary edge collapses along the boundary only.
-    if (free_placement && (on_boundary || plan.kept_in_place)) return false;
+    if (free_placement && (on_boundary || plan.kept_in_place || on_crease)) return false;
     const Vec3 normal = geom::vertex_normal(mesh_, kept) + geom::vertex_normal(mesh_, removed);
     Vec3 p = plan.position;
     if (free_placement) p = settle(p, collapse_neighbours(mesh_, plan.halfedge), normal);
-    if (!mesh_.is_boundary(kept) || mesh_.is_boundary(mesh_.edge_handle(plan.halfedge)))
+    if (!on_crease && (!mesh_.is_boundary(kept) || mesh_.is_boundary(mesh_.edge_handle(plan.halfedge))))
       p = project_vertex(mesh_, kept, p, normal, reference_, cache_of(kept));
     if (!collapse_geometry_ok(mesh_, plan.halfedge, p, e_max_)) return false;
     for (VertexHandle end : {kept, removed})
@@ -402,7 +405,10 @@ class Cleanup {
     // Through v0's kd-tree answer: exact wherever it came from (reference_surface.h), and the split
     // point lies next to v0.
     NeighbourCache* cache = cache_of(v0);
+    // An edge along a crease: the new vertex goes onto the crease (the chord of a bent one sags).
+    const bool crease = creases_ && creases_->along(a, b);
     auto project = [&](const Vec3& x) {
+      if (crease) return creases_->onto(x, a, b);
       if (!mesh_.is_boundary(e))
         return cache ? reference_.closest_point(x, normal, *cache) : reference_.closest_point(x, normal);
       return reference_.has_boundary() ? reference_.closest_boundary_point(x) : x;
@@ -411,7 +417,7 @@ class Cleanup {
     // The eq. 3.1 point leaves an edge outside: place the new vertex freely in the tangent plane
     // (along the edge on the boundary).
     if (!split_point_fits(e, p, around)) {
-      const Vec3 along = mesh_.is_boundary(e) ? (b - a).normalized() : Vec3(0, 0, 0);
+      const Vec3 along = mesh_.is_boundary(e) || crease ? (b - a).normalized() : Vec3(0, 0, 0);
       p = project(settle(p0, around, normal, along));
       if (!split_point_fits(e, p, around)) return false;
     }
@@ -464,11 +470,32 @@ class Cleanup {
     return (next - prev).normalized();
   }
 
+  /// Where v lies on the creases (Kind::None without them).
+  CreaseLines::Where crease_at(VertexHandle v) const {
+    return creases_ ? creases_->locate(mesh_.point(v)) : CreaseLines::Where{};
+  }
+
+  /// The direction a vertex on a crease line slides along (its crease's, through the points around).
+  static Vec3 crease_tangent(const CreaseLines::Where& where) {
+    const Vec3 d = where.ahead - where.back;
+    return d.sqrnorm() > 0 ? d.normalized() : Vec3(0, 0, 0);
+  }
+
+  /// Where a move of v to x (settled; the projection's input) ends: on the reference (projected),
+  /// or, for a vertex on a crease, along it (`where`; the crease lies on the reference).
+  Vec3 placed(VertexHandle v, const Vec3& x, const Vec3& n, const CreaseLines::Where& where, NeighbourCache* cache) {
+    if (where.kind != CreaseLines::Kind::None) return CreaseGuard::constrain(mesh_.point(v), where, x);
+    return project_vertex(mesh_, v, x, n, reference_, cache);
+  }
+
   bool relocate(VertexHandle v) {
     if (protect_tips_ && is_tip(mesh_, v)) return false;
     const bool boundary = mesh_.is_boundary(v);
-    const Vec3 tangent = boundary ? boundary_tangent(v) : Vec3(0, 0, 0);
-    if (boundary && tangent.sqrnorm() == 0) return false;
+    const CreaseLines::Where where = boundary ? CreaseLines::Where{} : crease_at(v);
+    if (where.kind == CreaseLines::Kind::Corner) return false;
+    const Vec3 tangent = boundary ? boundary_tangent(v)
+                         : where.kind == CreaseLines::Kind::Line ? crease_tangent(where) : Vec3(0, 0, 0);
+    if ((boundary || where.kind != CreaseLines::Kind::None) && tangent.sqrnorm() == 0) return false;
     const Vec3 start = mesh_.point(v);
     // Not one whose relocation failed with nothing near it changed since (failure memory): a
     // lookup, asked before the star is measured (a vertex of high valence is asked once for each
@@ -484,7 +511,7 @@ class Cleanup {
     ring.clear();
     for (auto w : mesh_.vv_range(v)) ring.push_back(mesh_.point(w));
     const Vec3 x = settle(start, ring, n, tangent);
-    const Vec3 p = project_vertex(mesh_, v, x, n, reference_, cache_of(v));
+    const Vec3 p = placed(v, x, n, where, cache_of(v));
     const auto [n_after, e_after] = outside_around(v, p);
     if (n_after > n_before || (n_after == n_before && !(e_after < 0.9 * e_before)) ||
         !geom::move_is_safe(mesh_, v, p)) {
@@ -600,13 +627,16 @@ class Cleanup {
         const VertexHandle v = patch[i];
         // A snap (judged) may move a tip: it moves vertices onto the input's own points.
         if (v == pinned || mesh_.is_boundary(v) || (protect_tips_ && !judge && is_tip(mesh_, v))) continue;
+        const CreaseLines::Where where = crease_at(v);
+        if (where.kind == CreaseLines::Kind::Corner) continue;
         ring.clear();
         for (auto w : mesh_.vv_range(v)) ring.push_back(mesh_.point(w));
         const Vec3 n = geom::vertex_normal(mesh_, v);
-        const Vec3 x = settle(mesh_.point(v), ring, n);
+        const Vec3 x = settle(mesh_.point(v), ring, n,
+                              where.kind == CreaseLines::Kind::Line ? crease_tangent(where) : Vec3(0, 0, 0));
         if (x == mesh_.point(v)) continue;  // its edges are well inside: settle leaves it, so does the projection
         NeighbourCache* cache = caches_ ? cache_of(v) : &patch_caches_[i];
-        const Vec3 p = project_vertex(mesh_, v, x, n, reference_, cache);
+        const Vec3 p = placed(v, x, n, where, cache);
         if (geom::move_is_safe(mesh_, v, p, adjacent_cos)) mesh_.point(v) = p, moved = 1;
       }
     }
@@ -630,6 +660,7 @@ class Cleanup {
   bool snap(const SnapMove& move, const PointIndex& features, std::size_t& budget) {
     const VertexHandle v = move.v;
     if (mesh_.is_boundary(v) || budget == 0) return false;
+    if (crease_at(v).kind != CreaseLines::Kind::None) return false;  // it stays on its crease
     // The patch's faces lie within kPatchRings + 1 edges of v.
     const double reach = (move.target - mesh_.point(v)).norm() + (kPatchRings + 1) * e_max_ + e_min_;
     const GapJudge judge(mesh_, patch_faces(v), move.target, features, e_min_, reach);
@@ -674,6 +705,7 @@ class Cleanup {
   double e_min_, e_max_, f_;
   bool collapsed_ = false;              ///< deleted elements to collect (finish)
   bool protect_tips_ = false;            ///< CleanupOptions::protect_tips
+  const CreaseGuard* creases_ = nullptr;  ///< CleanupOptions::creases (null when there are none)
   bool collapsed_since_round_ = false;  ///< a collapse in the current round
   std::vector<Vec3> ring_;        ///< a vertex's 1-ring points, for relocate and relax_patch (reused buffer)
   std::vector<char> patch_mark_;  ///< grow_rings' membership flags, all zero between calls
@@ -703,8 +735,9 @@ class Cleanup {
 
 std::size_t snap_to_features(TriMesh& mesh, const ReferenceSurface& reference, double e_min, double e_max,
                              const std::vector<SnapMove>& moves, const PointIndex& features,
-                             std::size_t& budget) {
+                             std::size_t& budget, const CreaseGuard* creases) {
   Cleanup cleanup(mesh, reference, e_min, e_max, 0.5);
+  cleanup.set_creases(creases);
   std::size_t moved = 0;
   for (const SnapMove& move : moves)
     if (cleanup.snap(move, features, budget)) ++moved;
@@ -717,6 +750,7 @@ CleanupCounts interval_cleanup(TriMesh& mesh, const ReferenceSurface& reference,
   if (options.patch_budget > 0) cleanup.set_patch_budget(options.patch_budget);
   cleanup.set_remember_failures(options.remember_failures);
   cleanup.set_protect_tips(options.protect_tips);
+  cleanup.set_creases(options.creases);
   cleanup.set_stop(options.stop);
   CleanupCounts counts;
   counts.outside_before = cleanup.count_outside();

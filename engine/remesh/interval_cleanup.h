@@ -24,6 +24,7 @@
 #include <vector>
 
 #include "core/mesh.h"
+#include "remesh/crease_lines.h"
 #include "remesh/point_index.h"
 #include "remesh/reference_surface.h"
 
@@ -62,6 +63,9 @@ struct CleanupOptions {
   /// there, the mesh valid (each fix is whole). A round on a pathological input (a polygon of
   /// thousands of sides) can take seconds, and a cancelled job waited for it.
   std::stop_token stop;
+  /// The reference's creases to keep (CreaseGuard, crease_lines.h): its flips, splits, collapses
+  /// and vertex moves follow the guard's rule. May be null.
+  const CreaseGuard* creases = nullptr;
 };
 
 /// Runs the cleanup. Precondition: no deleted elements (garbage-collected); it leaves the mesh
@@ -82,10 +86,11 @@ struct SnapMove {
 /// patch relaxation does; keeps a move only if it folds nothing, leaves no more edges of the patch
 /// outside [e_min, e_max] than before, brings its target nearer to the mesh, and leaves none of the
 /// `features` points near the patch farther from it than the larger of that point's and the
-/// target's distance before. Each try (a patch relaxation) takes one from `budget`; none is made
+/// target's distance before. With `creases`, a vertex on a crease is not moved off it: a move of
+/// one is refused, and a relaxed one slides along its crease. Each try (a patch relaxation) takes one from `budget`; none is made
 /// when it is 0. Returns the number of moves kept.
 std::size_t snap_to_features(TriMesh& mesh, const ReferenceSurface& reference, double e_min, double e_max,
                              const std::vector<SnapMove>& moves, const PointIndex& features,
-                             std::size_t& budget);
+                             std::size_t& budget, const CreaseGuard* creases = nullptr);
 
 }  // namespace remesh

@@ -13,8 +13,8 @@ namespace {
 
 class Regularizer {
  public:
-  Regularizer(TriMesh& mesh, double f, unsigned threads)
-      : mesh_(mesh), info_(mesh, threads), f_(f), marks_(mesh.n_vertices()) {}
+  Regularizer(TriMesh& mesh, double f, unsigned threads, const CreaseGuard* creases)
+      : mesh_(mesh), info_(mesh, threads), f_(f), marks_(mesh.n_vertices()), creases_(creases) {}
 
   std::size_t sweep(RegularizeCounts& counts) {
     std::size_t done = 0;
@@ -38,7 +38,7 @@ class Regularizer {
 
  private:
   /// Algorithm 4's safety checks and angle rule.
-  bool allowed(EdgeHandle e) const { return flip_is_safe(mesh_, e, f_, &info_); }
+  bool allowed(EdgeHandle e) const { return flip_is_safe(mesh_, e, f_, &info_, false, creases_); }
 
   void flip(EdgeHandle e, const Quad& q) {
     mesh_.flip(e);
@@ -79,13 +79,14 @@ class Regularizer {
   VertexInfo info_;
   double f_;
   SweepMarks marks_;
+  const CreaseGuard* creases_;
 };
 
 }  // namespace
 
-RegularizeCounts regularize(TriMesh& mesh, double f, int max_sweeps, unsigned threads) {
+RegularizeCounts regularize(TriMesh& mesh, double f, int max_sweeps, unsigned threads, const CreaseGuard* creases) {
   RegularizeCounts counts;
-  Regularizer r(mesh, f, threads);
+  Regularizer r(mesh, f, threads, creases);
   for (int s = 0; s < max_sweeps; ++s)
     if (r.sweep(counts) == 0) break;
   return counts;

@@ -15,6 +15,7 @@
 #include <cstddef>
 
 #include "core/mesh.h"
+#include "remesh/crease_lines.h"
 
 namespace remesh {
 
@@ -25,6 +26,8 @@ struct RegularizeCounts {
 
 /// Sweeps over the interior edges (in index order) while they flip something, at most `max_sweeps`.
 /// `threads` count the valences; the sweeps are serial.
-RegularizeCounts regularize(TriMesh& mesh, double f, int max_sweeps = 4, unsigned threads = 1);
+/// With `creases`, an edge along a crease is not flipped (flip_is_safe).
+RegularizeCounts regularize(TriMesh& mesh, double f, int max_sweeps = 4, unsigned threads = 1,
+                            const CreaseGuard* creases = nullptr);
 
 }  // namespace remesh

@@ -60,14 +60,17 @@ bool split_point_ok(const TriMesh& mesh, EdgeHandle e, const Vec3& p) {
 
 }  // namespace
 
-VertexHandle split_edge(TriMesh& mesh, EdgeHandle e, double target) {
+VertexHandle split_edge(TriMesh& mesh, EdgeHandle e, double target, const CreaseGuard* creases) {
   const HalfedgeHandle h = mesh.halfedge_handle(e, 0);
   const VertexHandle v0 = mesh.from_vertex_handle(h);
   const Vec3 a = mesh.point(v0), b = mesh.point(mesh.to_vertex_handle(h));
   const double t = equalizing_parameter(a, b, split_neighbours(mesh, e), target);
-  Vec3 p = a + (b - a) * t;
+  // An edge along a crease: its points go onto the crease (the chord of a bent one sags below it).
+  const bool crease = creases && creases->along(a, b);
+  auto placed = [&](const Vec3& q) { return crease ? creases->onto(q, a, b) : q; };
+  Vec3 p = placed(a + (b - a) * t);
   if (!split_point_ok(mesh, e, p)) {
-    p = (a + b) * 0.5;
+    p = placed((a + b) * 0.5);
     if (!split_point_ok(mesh, e, p)) return VertexHandle();
   }
   return mesh.split(e, p);
@@ -128,11 +131,62 @@ bool collapse_geometry_ok(const TriMesh& mesh, HalfedgeHandle h, const Vec3& p, 
 
 bool is_tip(const TriMesh& mesh, VertexHandle v) { return geom::angle_deficit(mesh, v) > kTipDeficit; }
 
+namespace {
+
+/// CreaseGuard's part of a collapse (see plan_collapse in the header). 0: the creases do not
+/// decide; 1: they do (h oriented so that its to-vertex is kept, `p` set, `in_place` when that end
+/// stays); -1: refused.
+int crease_collapse(const TriMesh& mesh, HalfedgeHandle& h, const CreaseGuard& creases, double target, Vec3& p,
+                    bool& in_place) {
+  if (creases.empty()) return 0;
+  VertexHandle v0 = mesh.from_vertex_handle(h), v1 = mesh.to_vertex_handle(h);
+  const Vec3 a = mesh.point(v0), b = mesh.point(v1);
+  const CreaseLines::Kind k0 = creases.locate(a).kind, k1 = creases.locate(b).kind;
+  using Kind = CreaseLines::Kind;
+  if (k0 == Kind::None && k1 == Kind::None) return 0;
+  const bool along = k0 != Kind::None && k1 != Kind::None && creases.along(a, b);
+  if (k0 != Kind::None && k1 != Kind::None && !along) return -1;  // across: would join two creases
+  if (along && k0 == Kind::Corner && k1 == Kind::Corner) return -1;
+  // The end that stays: the one on a crease (not along), or the corner (along).
+  const bool keep0 = along ? k0 == Kind::Corner : k0 != Kind::None;
+  const bool keep1 = along ? k1 == Kind::Corner : k1 != Kind::None;
+  if (keep0) h = mesh.opposite_halfedge_handle(h), std::swap(v0, v1);
+  if (keep0 || keep1) {
+    p = mesh.point(v1);
+    in_place = true;
+  } else {
+    const Vec3 q = mesh.point(v0), r = mesh.point(v1);
+    p = creases.onto(q + (r - q) * equalizing_parameter(q, r, collapse_neighbours(mesh, h), target), q, r);
+    in_place = false;
+  }
+  return 1;
+}
+
+}  // namespace
+
 bool plan_collapse(const TriMesh& mesh, EdgeHandle e, double target, double max_length, CollapsePlan& plan,
-                   bool keep_tips) {
+                   bool keep_tips, const CreaseGuard* creases) {
   HalfedgeHandle h = mesh.halfedge_handle(e, 0);
   VertexHandle v0 = mesh.from_vertex_handle(h), v1 = mesh.to_vertex_handle(h);
   if (!component_larger_than(mesh, v0, 4)) return false;
+  if (creases && !creases->empty() && (mesh.is_boundary(v0) || mesh.is_boundary(v1))) {
+    // Where a boundary and a crease meet, neither rule may move the other's vertex: a collapse
+    // with a crease vertex at either end of an edge touching the boundary is not made.
+    if (creases->on(mesh.point(v0)) || creases->on(mesh.point(v1))) return false;
+  } else if (creases) {
+    Vec3 p;
+    bool in_place = false;
+    const int decided = crease_collapse(mesh, h, *creases, target, p, in_place);
+    if (decided < 0) return false;
+    if (decided > 0) {
+      if (!const_cast<TriMesh&>(mesh).is_collapse_ok(h)) return false;
+      if (!collapse_geometry_ok(mesh, h, p, max_length)) return false;
+      plan.halfedge = h;
+      plan.position = p;
+      plan.kept_in_place = in_place;
+      return true;
+    }
+  }
   const bool b0 = mesh.is_boundary(v0), b1 = mesh.is_boundary(v1), along_boundary = mesh.is_boundary(e);
   if (along_boundary) {
     if (!boundary_loop_longer_than_3(mesh, h)) return false;
@@ -178,7 +232,8 @@ VertexHandle apply_collapse(TriMesh& mesh, const CollapsePlan& plan) {
 
 double collapse_length_limit(double m_i, double sigma) { return std::max(m_i + sigma, 2.0 * (m_i - sigma)); }
 
-StellarCounts stellar_operations(TriMesh& mesh, const std::vector<unsigned>& list, double m_i, double sigma) {
+StellarCounts stellar_operations(TriMesh& mesh, const std::vector<unsigned>& list, double m_i, double sigma,
+                                 const CreaseGuard* creases) {
   StellarCounts counts;
   std::vector<char> visited(mesh.n_vertices(), 0);
   auto visit_star = [&](VertexHandle v) {
@@ -194,13 +249,13 @@ StellarCounts stellar_operations(TriMesh& mesh, const std::vector<unsigned>& lis
     if (visited[v0.idx()] && visited[v1.idx()]) continue;
     const double length = mesh.calc_edge_length(e);
     if (length > m_i + sigma) {
-      const VertexHandle v = split_edge(mesh, e, m_i);
+      const VertexHandle v = split_edge(mesh, e, m_i, creases);
       if (!v.is_valid()) continue;
       ++counts.splits;
       visit_star(v);
     } else if (length < m_i - sigma) {
       CollapsePlan plan;
-      if (!plan_collapse(mesh, e, m_i, collapse_length_limit(m_i, sigma), plan)) continue;
+      if (!plan_collapse(mesh, e, m_i, collapse_length_limit(m_i, sigma), plan, true, creases)) continue;
       visit_star(apply_collapse(mesh, plan));
       ++counts.collapses;
     }

@@ -29,9 +29,11 @@ VertexInfo::VertexInfo(const TriMesh& mesh, unsigned threads)
   });
 }
 
-bool flip_is_safe(const TriMesh& mesh, EdgeHandle e, double f, const VertexInfo* info, bool turned_ok) {
+bool flip_is_safe(const TriMesh& mesh, EdgeHandle e, double f, const VertexInfo* info, bool turned_ok,
+                  const CreaseGuard* creases) {
   if (mesh.status(e).deleted() || mesh.is_boundary(e) || !mesh.is_flip_ok(e)) return false;
   const Quad q = quad_of(mesh, e);
+  if (creases && creases->along(mesh.point(q.v0), mesh.point(q.v1))) return false;
   // The ends lose an edge: keep interior valence >= 3 and boundary valence >= 2.
   for (VertexHandle v : {q.v0, q.v1}) {
     const bool boundary = info ? info->boundary[v.idx()] != 0 : mesh.is_boundary(v);
@@ -93,13 +95,13 @@ namespace {
 
 /// One sweep over the interior edges in index order; with `marks`, only those it says may have
 /// changed.
-std::size_t sweep(TriMesh& mesh, double f, VertexInfo& info, SweepMarks* marks) {
+std::size_t sweep(TriMesh& mesh, double f, VertexInfo& info, SweepMarks* marks, const CreaseGuard* creases) {
   std::size_t flips = 0;
   auto visit = [&](EdgeHandle e) {
     if (mesh.is_boundary(e)) return;
     const Quad q = quad_of(mesh, e);
     if (marks && !marks->any(q)) return;
-    if (!info.improves(q) || !flip_is_safe(mesh, e, f, &info)) return;
+    if (!info.improves(q) || !flip_is_safe(mesh, e, f, &info, false, creases)) return;
     mesh.flip(e);
     info.flipped(q);
     if (marks)
@@ -118,15 +120,15 @@ std::size_t sweep(TriMesh& mesh, double f, VertexInfo& info, SweepMarks* marks) 
 
 std::size_t valence_flip_sweep(TriMesh& mesh, double f) {
   VertexInfo info(mesh);
-  return sweep(mesh, f, info, nullptr);
+  return sweep(mesh, f, info, nullptr, nullptr);
 }
 
-std::size_t valence_flips(TriMesh& mesh, double f, int max_sweeps, unsigned threads) {
+std::size_t valence_flips(TriMesh& mesh, double f, int max_sweeps, unsigned threads, const CreaseGuard* creases) {
   std::size_t total = 0;
   VertexInfo info(mesh, threads);
   SweepMarks marks(mesh.n_vertices());
   for (int s = 0; s < max_sweeps; ++s) {
-    const std::size_t n = sweep(mesh, f, info, &marks);
+    const std::size_t n = sweep(mesh, f, info, &marks, creases);
     total += n;
     if (n == 0) break;
     marks.next_sweep();

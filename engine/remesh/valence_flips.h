@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "core/mesh.h"
+#include "remesh/crease_lines.h"
 
 namespace remesh {
 
@@ -116,14 +117,16 @@ std::size_t valence_flip_sweep(TriMesh& mesh, double f);
 /// Sweeps while they still flip something, at most `max_sweeps` times (the thesis does one; more
 /// sweeps raise regularity at little cost). Returns the total number of flips. `threads` count the
 /// valences; the sweeps are serial.
-std::size_t valence_flips(TriMesh& mesh, double f, int max_sweeps = 3, unsigned threads = 1);
+std::size_t valence_flips(TriMesh& mesh, double f, int max_sweeps = 3, unsigned threads = 1,
+                          const CreaseGuard* creases = nullptr);
 
 /// Safety part of a flip alone (legal, no fold, no degenerate triangle, minimum angle no lower than
 /// f * before). Used by the interval cleanup too. With `info` (current for `mesh`), the ends'
 /// valences come from it instead of circulating them: the same answer. With `turned_ok`, the new
 /// faces need not agree with the old ones (untangle.h: a tangle's faces are turned already); the
 /// tests of adjacent faces still refuse a face turned over against its neighbours.
+/// With `creases`, an edge along a crease is not flipped (CreaseGuard, crease_lines.h).
 bool flip_is_safe(const TriMesh& mesh, OpenMesh::EdgeHandle e, double f, const VertexInfo* info = nullptr,
-                  bool turned_ok = false);
+                  bool turned_ok = false, const CreaseGuard* creases = nullptr);
 
 }  // namespace remesh

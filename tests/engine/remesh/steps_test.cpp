@@ -505,6 +505,150 @@ TEST_CASE("the filter moves a vertex on a crease along it only", "[steps]") {
   CHECK(across == 256);
 }
 
+namespace {
+
+/// A strip folded at a right angle along the y axis: 12 edges on the fold, and on either side one
+/// vertex 0.4 across from the middle of each of them. (A flip of a fold edge tilts its new faces by
+/// 49 degrees against the old: allowed, kMinNormalCos. With vertices 0.8 across: 62, refused.)
+TriMesh make_folded_strip() {
+  TriMesh mesh;
+  std::vector<OpenMesh::VertexHandle> f, l, r;
+  for (int k = 0; k <= 12; ++k) f.push_back(mesh.add_vertex(Vec3(0, k, 0)));
+  for (int k = 0; k < 12; ++k) {
+    l.push_back(mesh.add_vertex(Vec3(-0.4, k + 0.5, 0)));
+    r.push_back(mesh.add_vertex(Vec3(0, k + 0.5, 0.4)));
+  }
+  for (int k = 0; k < 12; ++k) {
+    mesh.add_face(f[k], l[k], f[k + 1]);
+    mesh.add_face(f[k + 1], r[k], f[k]);
+    if (k + 1 < 12) {
+      mesh.add_face(l[k], l[k + 1], f[k + 1]);
+      mesh.add_face(r[k], f[k + 1], r[k + 1]);
+    }
+  }
+  return mesh;
+}
+
+OpenMesh::EdgeHandle edge_between(const TriMesh& mesh, const Vec3& a, const Vec3& b) {
+  for (auto e : mesh.edges()) {
+    const auto h = mesh.halfedge_handle(e, 0);
+    const Vec3 &p = mesh.point(mesh.from_vertex_handle(h)), &q = mesh.point(mesh.to_vertex_handle(h));
+    if (((p - a).norm() < 1e-12 && (q - b).norm() < 1e-12) || ((p - b).norm() < 1e-12 && (q - a).norm() < 1e-12))
+      return e;
+  }
+  return OpenMesh::EdgeHandle();
+}
+
+}  // namespace
+
+TEST_CASE("the crease guard: no flip of an edge along a crease", "[steps]") {
+  const TriMesh mesh = make_folded_strip();
+  const CreaseLines creases(mesh);
+  REQUIRE(creases.size() == 12);
+  const CreaseGuard guard(creases, 1e-9);
+  std::size_t along = 0, flippable = 0;
+  for (auto e : mesh.edges()) {
+    const auto h = mesh.halfedge_handle(e, 0);
+    const Vec3 &a = mesh.point(mesh.from_vertex_handle(h)), &b = mesh.point(mesh.to_vertex_handle(h));
+    const bool on_fold = a[0] == 0 && b[0] == 0 && a[2] == 0 && b[2] == 0 && a[1] != b[1];
+    CHECK(guard.along(a, b) == on_fold);
+    if (!on_fold) continue;
+    ++along;
+    // A flip across the fold passes every other rule: the remeshed surface would cut the crease.
+    if (!flip_is_safe(mesh, e, 0.0)) continue;
+    ++flippable;
+    CHECK_FALSE(flip_is_safe(mesh, e, 0.0, nullptr, false, &guard));
+  }
+  CHECK(along == 12);
+  CHECK(flippable > 0);
+}
+
+TEST_CASE("the crease guard: splits and collapses keep a bent crease", "[steps]") {
+  // The reference: a cylinder of 32 segments; the mesh: one of 16, whose rim edges are chords of
+  // two of the reference's rim segments (their midpoints 0.0144 inside the crease).
+  const TriMesh reference = test::make_sliver_cylinder(32, 1.0, 2.0);
+  const CreaseLines creases(reference);
+  const CreaseGuard guard(creases, 1e-9);
+  const Vec3 p0(1, 0, 2), p1(std::cos(M_PI / 8), std::sin(M_PI / 8), 2);
+  SECTION("a split of a rim edge puts its vertex on the rim") {
+    for (const bool guarded : {false, true}) {
+      TriMesh mesh = test::make_sliver_cylinder(16, 1.0, 2.0);
+      const auto e = edge_between(mesh, p0, p1);
+      REQUIRE(e.is_valid());
+      REQUIRE(guard.along(p0, p1));
+      const auto v = split_edge(mesh, e, 0.2, guarded ? &guard : nullptr);
+      REQUIRE(v.is_valid());
+      CHECK(guard.on(mesh.point(v)) == guarded);
+      CHECK(test::check_mesh_valid(mesh) == "");
+    }
+  }
+  SECTION("a collapse along the rim puts its vertex on the rim; one onto the rim keeps the rim vertex") {
+    TriMesh mesh = test::make_sliver_cylinder(16, 1.0, 2.0);
+    CollapsePlan plan;
+    REQUIRE(plan_collapse(mesh, edge_between(mesh, p0, p1), 0.2, 10.0, plan, true, &guard));
+    CHECK(guard.on(plan.position));
+    CHECK_FALSE(plan.kept_in_place);
+    REQUIRE(plan_collapse(mesh, edge_between(mesh, p0, p1), 0.2, 10.0, plan, true, nullptr));
+    CHECK_FALSE(guard.on(plan.position));  // eq. 3.1's point on the chord
+    // A spoke (the cap's centre to the rim): the rim end stays.
+    REQUIRE(plan_collapse(mesh, edge_between(mesh, Vec3(0, 0, 2), p0), 0.2, 10.0, plan, true, &guard));
+    CHECK(plan.kept_in_place);
+    CHECK(plan.position == p0);
+    CHECK(mesh.point(mesh.to_vertex_handle(plan.halfedge)) == p0);
+  }
+  SECTION("an edge between two creases is not collapsed") {
+    TriMesh mesh = test::make_sliver_cylinder(16, 1.0, 2.0);
+    const auto side = edge_between(mesh, Vec3(1, 0, 0), Vec3(1, 0, 2));
+    REQUIRE(side.is_valid());
+    CollapsePlan plan;
+    CHECK_FALSE(plan_collapse(mesh, side, 0.2, 10.0, plan, true, &guard));
+  }
+}
+
+TEST_CASE("the crease guard moves a vertex along its crease only", "[steps]") {
+  const TriMesh reference = test::make_sliver_cylinder(128, 1.0, 2.0);
+  const CreaseLines creases(reference);
+  const Vec3 p(1, 0, 2);
+  const CreaseLines::Where at = creases.locate(p, 1e-9);
+  REQUIRE(at.kind == CreaseLines::Kind::Line);
+  const Vec3 moved = CreaseGuard::constrain(p, at, Vec3(0.5, 0.5, 1.7));
+  CHECK(moved != p);
+  CHECK(creases.locate(moved, 1e-9).kind != CreaseLines::Kind::None);
+  CHECK(CreaseGuard::constrain(p, CreaseLines::Where{CreaseLines::Kind::Corner, {}, {}}, Vec3(0, 0, 0)) == p);
+  CHECK(CreaseGuard::constrain(p, CreaseLines::Where{}, Vec3(0, 0, 0)) == Vec3(0, 0, 0));
+}
+
+TEST_CASE("a crease joins two points along it, not two creases side by side", "[steps]") {
+  const TriMesh cylinder = test::make_sliver_cylinder(128, 1.0, 2.0);
+  const CreaseLines creases(cylinder);
+  // The k-th point of a rim (the input's vertices; the rims are polylines through them).
+  auto rim = [](int k, double z) {
+    const double a = 2 * M_PI * k / 128;
+    return Vec3(std::cos(a), std::sin(a), z);
+  };
+  // Along the top rim over 4 segments (a chord of 0.1960, an arc of 0.1963), the path's segments
+  // with it.
+  std::vector<std::array<Vec3, 2>> path;
+  CHECK(creases.joined(rim(0, 2), rim(4, 2), 1e-9, 0.2, &path));
+  CHECK(path.size() == 4);
+  CHECK_FALSE(creases.joined(rim(0, 2), rim(4, 2), 1e-9, 0.195));  // the arc is longer
+  CHECK(creases.joined(0.5 * (rim(0, 2) + rim(1, 2)), rim(4, 2), 1e-9, 0.2));  // from inside a segment
+  // Not from the top rim to the bottom one (parallel creases 2 apart), nor from off a crease.
+  CHECK_FALSE(creases.joined(rim(0, 2), rim(0, 0), 1e-9, 10.0));
+  CHECK_FALSE(creases.joined(Vec3(0, 0, 2), rim(0, 2), 1e-9, 10.0));
+  // The crease guard's rule: an edge along the rim is along a crease, a side edge is not.
+  const CreaseGuard guard(creases, 1e-9);
+  CHECK(guard.along(rim(0, 2), rim(4, 2)));
+  CHECK_FALSE(guard.along(rim(0, 2), rim(0, 0)));
+  CHECK_FALSE(guard.along(rim(0, 2), rim(36, 0)));
+  // onto(): a point of the chord goes to the rim between its ends.
+  const Vec3 mid = 0.5 * (rim(0, 2) + rim(4, 2));
+  const Vec3 q = guard.onto(mid, rim(0, 2), rim(4, 2));
+  CHECK(guard.on(q));
+  CHECK((q - mid).norm() < 0.005);
+  CHECK(guard.onto(mid, rim(0, 2), rim(0, 0)) == mid);  // no crease joins them
+}
+
 TEST_CASE("the interval guard moves back, half way at a time, what took edges out of the interval", "[steps]") {
   // Every edge 1.5, inside [1.2, 1.8]; a random move of up to 0.35 per coordinate takes many out.
   for (const int halvings : {0, 3}) {
