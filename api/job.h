@@ -61,8 +61,9 @@ struct JobRecord {
   /// against [e_min, e_max] / sqrt(3); nullopt until the job succeeded.
   std::optional<DualStats> dual;
   std::optional<std::string> error;
-  /// Runs started. Counted when a run starts and taken back when the service stops it on shutdown:
-  /// a run the process did not live through (a crash, a kill) stays counted. A job counted already
+  /// Runs started. Counted when a run starts and taken back when a shutdown is asked for (stored
+  /// then, before the run stops: a kill during the grace period does not count it); a run the
+  /// process did not live through otherwise (a crash, a kill) stays counted. A job counted already
   /// runs alone after a restart (nothing beside it), and one counted kMaxAttempts times is not run
   /// again (it fails, named so): an input that crashes the engine cannot take the service down at
   /// every start, and a job that only ran beside it is not blamed.

@@ -100,7 +100,7 @@ class JobManager {
     std::vector<remesh::IterationStats> rows;
     std::vector<JobEvent> events;
     std::stop_source stop;
-    bool interrupted = false;  ///< stopped by shutdown, not by the user
+    bool interrupted = false;  ///< stopped by shutdown, not by the user; its run taken back already
   };
 
   void worker_loop();
