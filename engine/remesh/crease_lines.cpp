@@ -88,6 +88,7 @@ CreaseLines::CreaseLines(const TriMesh& reference, const std::vector<OpenMesh::E
     }
   }
   reach_ = 0.5 * step;
+  for (const Vec3& s : samples) box_.add(s);
   samples_ = PointIndex(std::move(samples));
   corner_.assign(points_.size(), 0);
   along_.assign(points_.size(), {0, 0});
@@ -107,8 +108,10 @@ CreaseLines::CreaseLines(const TriMesh& reference, const std::vector<OpenMesh::E
 
 const std::vector<std::uint32_t>& CreaseLines::segments_near(const Vec3& p, double tol) const {
   thread_local std::vector<std::uint32_t> near, segments;
-  samples_.within(p, reach_ + tol * 2, near);
   segments.clear();
+  const double radius = reach_ + tol * 2;
+  if (box_.squared_distance(p) >= radius * radius) return segments;
+  samples_.within(p, radius, near);
   for (std::uint32_t sample : near) {
     const std::uint32_t g = sample_segment_[sample];
     if (!segments.empty() && segments.back() == g) continue;  // a segment's samples are consecutive

@@ -14,7 +14,9 @@
 /// iterations, every vertex on the surface (also with 64 and 500 segments, and at [0.04, 0.06] and
 /// [0.15, 0.225]; a washer's bent inner rim too), the rims' points within 0.05. The creases are
 /// not kept exactly: Algorithm 3's splits and collapses of the mesh's edges along a crease put
-/// their vertex on the chord, and the projection takes it to one side.
+/// their vertex on the chord, and the projection takes it to one side. With Params::keep_creases
+/// every step follows CreaseGuard (below) and they are kept: a box's edges within 1e-9, the
+/// cylinder's rims within the sag of an edge over the input's polyline (0.002 at [0.08, 0.12]).
 
 #include <array>
 #include <cstddef>
@@ -22,6 +24,7 @@
 #include <vector>
 
 #include "core/mesh.h"
+#include "remesh/geometry.h"
 #include "remesh/point_index.h"
 
 namespace remesh {
@@ -85,6 +88,10 @@ class CreaseLines {
   PointIndex samples_;                  ///< points along the segments (crease_lines.cpp)
   std::vector<std::uint32_t> sample_segment_;  ///< by sample: its segment
   double reach_ = 0;                    ///< half the samples' largest spacing
+  /// The samples' bounding box: a point farther from it than reach_ + 2 tol is near no crease,
+  /// known without the kd-tree (a scan's few creases: nefertiti's 10 edges cost its run with
+  /// keep_creases 8.9 s instead of 6.2 before this test, every flip asking for both ends).
+  Box box_;
 };
 
 /// Not in the thesis: the rule every step of a run follows so that the reference's creases stay in

@@ -25,8 +25,10 @@ std::size_t undo_folds(TriMesh& mesh, const std::vector<Vec3>& before, unsigned 
 /// now gets both ends moved half way back to `before` (`halvings` times at most, then all the way),
 /// repeatedly until no such edge is left. Returns the number of moves back. With `reference`, a
 /// point half way back is projected onto it: between two points of a curved surface the midpoint
-/// lies under it (a cylinder of radius 1 at [0.08, 0.12]: 16 vertices up to 7.8e-5 off its surface).
+/// lies under it (a cylinder of radius 1 at [0.08, 0.12]: 16 vertices up to 7.8e-5 off its surface),
+/// through the vertices' kd-tree answers in `caches` (by vertex index, projection.h) when given.
 std::size_t undo_interval_breaks(TriMesh& mesh, const std::vector<Vec3>& before, double e_min, double e_max,
-                                 int halvings = 3, const ReferenceSurface* reference = nullptr);
+                                 int halvings = 3, const ReferenceSurface* reference = nullptr,
+                                 std::vector<NeighbourCache>* caches = nullptr);
 
 }  // namespace remesh

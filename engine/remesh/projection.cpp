@@ -14,6 +14,19 @@ Vec3 project_vertex(const TriMesh& mesh, OpenMesh::VertexHandle v, const Vec3& p
   return cache ? reference.closest_point(p, normal, *cache) : reference.closest_point(p, normal);
 }
 
+std::size_t project_vertices(TriMesh& mesh, const std::vector<OpenMesh::VertexHandle>& vertices,
+                             const ReferenceSurface& reference) {
+  std::size_t moved = 0;
+  for (auto v : vertices) {
+    if (mesh.status(v).deleted() || mesh.is_isolated(v)) continue;
+    const Vec3 p = project_vertex(mesh, v, mesh.point(v), geom::vertex_normal(mesh, v), reference);
+    if (p == mesh.point(v) || !geom::move_is_safe(mesh, v, p)) continue;
+    mesh.point(v) = p;
+    ++moved;
+  }
+  return moved;
+}
+
 double project_onto_reference(TriMesh& mesh, const ReferenceSurface& reference, unsigned threads,
                               std::vector<NeighbourCache>* caches) {
   const std::size_t n = mesh.n_vertices();

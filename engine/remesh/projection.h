@@ -20,6 +20,12 @@ namespace remesh {
 double project_onto_reference(TriMesh& mesh, const ReferenceSurface& reference, unsigned threads,
                               std::vector<NeighbourCache>* caches = nullptr);
 
+/// Projects the given vertices (live ones; the others are passed over) onto `reference`, each
+/// only where the move folds nothing (geom::move_is_safe), one after the other. Returns how many
+/// moved.
+std::size_t project_vertices(TriMesh& mesh, const std::vector<OpenMesh::VertexHandle>& vertices,
+                             const ReferenceSurface& reference);
+
 /// The position one vertex would take: closest_boundary_point for boundary vertices, else
 /// closest_point with `normal` as the hint (through `cache` when given).
 Vec3 project_vertex(const TriMesh& mesh, OpenMesh::VertexHandle v, const Vec3& p, const Vec3& normal,

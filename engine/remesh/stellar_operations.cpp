@@ -233,7 +233,7 @@ VertexHandle apply_collapse(TriMesh& mesh, const CollapsePlan& plan) {
 double collapse_length_limit(double m_i, double sigma) { return std::max(m_i + sigma, 2.0 * (m_i - sigma)); }
 
 StellarCounts stellar_operations(TriMesh& mesh, const std::vector<unsigned>& list, double m_i, double sigma,
-                                 const CreaseGuard* creases) {
+                                 const CreaseGuard* creases, std::vector<VertexHandle>* placed) {
   StellarCounts counts;
   std::vector<char> visited(mesh.n_vertices(), 0);
   auto visit_star = [&](VertexHandle v) {
@@ -253,11 +253,14 @@ StellarCounts stellar_operations(TriMesh& mesh, const std::vector<unsigned>& lis
       if (!v.is_valid()) continue;
       ++counts.splits;
       visit_star(v);
+      if (placed) placed->push_back(v);
     } else if (length < m_i - sigma) {
       CollapsePlan plan;
       if (!plan_collapse(mesh, e, m_i, collapse_length_limit(m_i, sigma), plan, true, creases)) continue;
-      visit_star(apply_collapse(mesh, plan));
+      const VertexHandle kept = apply_collapse(mesh, plan);
+      visit_star(kept);
       ++counts.collapses;
+      if (placed && !plan.kept_in_place) placed->push_back(kept);
     }
   }
   return counts;

@@ -105,7 +105,10 @@ struct StellarCounts {
 /// Algorithm 3 over `list` (edge indices, worst first): long (> m_i + sigma) -> split, short
 /// (< m_i - sigma) -> collapse; skips edges that are gone or whose ends were both visited. With
 /// `creases`, splits and collapses keep the creases (split_edge, plan_collapse).
+/// With `placed`, the vertices whose point an operation chose (a split's new vertex, a collapse's
+/// kept one when it moved) are appended to it.
 StellarCounts stellar_operations(TriMesh& mesh, const std::vector<unsigned>& list, double m_i, double sigma,
-                                 const CreaseGuard* creases = nullptr);
+                                 const CreaseGuard* creases = nullptr,
+                                 std::vector<OpenMesh::VertexHandle>* placed = nullptr);
 
 }  // namespace remesh

@@ -649,6 +649,22 @@ TEST_CASE("a crease joins two points along it, not two creases side by side", "[
   CHECK(guard.onto(mid, rim(0, 2), rim(0, 0)) == mid);  // no crease joins them
 }
 
+TEST_CASE("project_vertices puts the placed vertices on the reference, the others stay", "[steps]") {
+  const TriMesh reference = test::make_icosphere(3, 10.0);
+  const ReferenceSurface surface(reference);
+  TriMesh mesh = reference;
+  // Every 7th vertex pushed 2 % inwards (a split's point on its edge's chord lies under a sphere).
+  std::vector<OpenMesh::VertexHandle> placed;
+  for (auto v : mesh.vertices())
+    if (v.idx() % 7 == 0) mesh.point(v) *= 0.98, placed.push_back(v);
+  const OpenMesh::VertexHandle other = mesh.vertex_handle(1);
+  mesh.point(other) *= 0.98;  // pushed too, but not placed
+  CHECK(project_vertices(mesh, placed, surface) == placed.size());
+  for (auto v : placed) CHECK(test::brute_distance(reference, mesh.point(v)) < 1e-9);
+  CHECK(test::brute_distance(reference, mesh.point(other)) > 0.1);
+  CHECK(test::check_mesh_valid(mesh) == "");
+}
+
 TEST_CASE("the interval guard moves back, half way at a time, what took edges out of the interval", "[steps]") {
   // Every edge 1.5, inside [1.2, 1.8]; a random move of up to 0.35 per coordinate takes many out.
   for (const int halvings : {0, 3}) {
