@@ -190,6 +190,15 @@ bool CreaseGuard::along(const Vec3& a, const Vec3& b) const {
   return lines_->joined(a, b, tol_, kArcShare * (b - a).norm() + tol_);
 }
 
+bool CreaseGuard::along(const TriMesh& mesh, OpenMesh::EdgeHandle e) const {
+  if (empty() || mesh.is_boundary(e)) return false;
+  const auto h = mesh.halfedge_handle(e, 0);
+  const Vec3 n0 = geom::face_normal(mesh, mesh.face_handle(h));
+  const Vec3 n1 = geom::face_normal(mesh, mesh.opposite_face_handle(h));
+  if (geom::normals_agree(n0, n1, kAlongCos)) return false;
+  return along(mesh.point(mesh.from_vertex_handle(h)), mesh.point(mesh.to_vertex_handle(h)));
+}
+
 Vec3 CreaseGuard::onto(const Vec3& p, const Vec3& a, const Vec3& b) const {
   thread_local std::vector<std::array<Vec3, 2>> path;
   path.clear();

@@ -109,16 +109,28 @@ class CreaseLines {
 /// Measured in equalize.cpp (kept_creases).
 class CreaseGuard {
  public:
-  /// A chord over an arc of 90 degrees is 0.90 as long as the arc.
+  /// The crease between an edge's ends may be this much longer than the edge (a chord over an arc
+  /// of 90 degrees is 0.90 as long as the arc; 1.5 lets arcs up to 150 degrees pass, so the mesh
+  /// edge's own faces must show the crease too: kAlongCos).
   static constexpr double kArcShare = 1.5;
+  /// A mesh edge runs along a crease only where its two faces meet at more than about 26 degrees
+  /// (cosine between their normals below this). A chord across a cylinder's flat cap joins two
+  /// points of its rim, and a crease of 90 degrees or less joins them: counted along it, the chord
+  /// could not be flipped, and a split put its point on the rim, turning faces over (a cylinder of
+  /// 64 segments whose caps are fans from a rim vertex, [0.08, 0.12]: 60.7 % inside, 5 728 folded
+  /// pairs of faces; with this test 99.985 %, none).
+  static constexpr double kAlongCos = 0.9;
 
   CreaseGuard(const CreaseLines& lines, double tol) : lines_(&lines), tol_(tol) {}
 
   bool empty() const { return lines_->empty(); }
   CreaseLines::Where locate(const Vec3& p) const { return lines_->locate(p, tol_); }
   bool on(const Vec3& p) const { return !empty() && locate(p).kind != CreaseLines::Kind::None; }
-  /// Does the edge (a, b) run along a crease? (See the class comment.)
+  /// Do the points a and b lie on one crease, joined as the class comment says?
   bool along(const Vec3& a, const Vec3& b) const;
+  /// Does the mesh edge e run along a crease: its ends joined by one (along(a, b)) and its two
+  /// faces meeting at an angle (kAlongCos)? A boundary edge never does.
+  bool along(const TriMesh& mesh, OpenMesh::EdgeHandle e) const;
   /// The point closest to p of the crease that joins a and b (the ends of an edge along it; p a
   /// point of the edge); p itself when none joins them.
   Vec3 onto(const Vec3& p, const Vec3& a, const Vec3& b) const;

@@ -5,6 +5,7 @@
 
 #include "core/parallel.h"
 #include "remesh/geometry.h"
+#include "remesh/projection.h"
 
 namespace remesh {
 
@@ -110,12 +111,13 @@ std::size_t undo_interval_breaks(TriMesh& mesh, const std::vector<Vec3>& before,
     }
     return moved;
   };
-  std::vector<OpenMesh::VertexHandle> halved;  // every vertex moved, once
+  std::vector<OpenMesh::VertexHandle> halved;  // every vertex moved, once each
+  std::vector<char> listed(reference ? mesh.n_vertices() : 0, 0);
   while (!queue.empty()) {
     const std::vector<OpenMesh::VertexHandle> moved = move_back(queue);
     queue.clear();
     for (auto v : moved) {
-      if (retreats[v.idx()] == 1) halved.push_back(v);
+      if (reference && !listed[v.idx()]) listed[v.idx()] = 1, halved.push_back(v);
       for (auto e : mesh.ve_range(v))
         if (broken(e)) queue.push_back(e);
     }
@@ -126,10 +128,8 @@ std::size_t undo_interval_breaks(TriMesh& mesh, const std::vector<Vec3>& before,
   for (auto v : halved) {
     const Vec3& was = before[v.idx()];
     if (mesh.point(v) == was) continue;
-    const Vec3 normal = geom::vertex_normal(mesh, v);
-    mesh.point(v) = caches && static_cast<std::size_t>(v.idx()) < caches->size()
-                        ? reference->closest_point(mesh.point(v), normal, (*caches)[v.idx()])
-                        : reference->closest_point(mesh.point(v), normal);
+    NeighbourCache* cache = caches && static_cast<std::size_t>(v.idx()) < caches->size() ? &(*caches)[v.idx()] : nullptr;
+    mesh.point(v) = project_vertex(mesh, v, mesh.point(v), geom::vertex_normal(mesh, v), *reference, cache);
     retreats[v.idx()] = static_cast<std::uint8_t>(halvings);  // a next move goes all the way
     for (auto e : mesh.ve_range(v))
       if (broken(e)) queue.push_back(e);

@@ -406,7 +406,7 @@ class Cleanup {
     // point lies next to v0.
     NeighbourCache* cache = cache_of(v0);
     // An edge along a crease: the new vertex goes onto the crease (the chord of a bent one sags).
-    const bool crease = creases_ && creases_->along(a, b);
+    const bool crease = creases_ && creases_->along(mesh_, e);
     auto project = [&](const Vec3& x) {
       if (crease) return creases_->onto(x, a, b);
       if (!mesh_.is_boundary(e))

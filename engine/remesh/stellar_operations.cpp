@@ -44,7 +44,8 @@ namespace {
 constexpr double kSplitAngleSlack = 1e-3;
 
 /// Would the triangles made by splitting e at p be non-degenerate (no worse than kMinAngle, or than
-/// the triangle they replace, up to kSplitAngleSlack)?
+/// the triangle they replace, up to kSplitAngleSlack) and unfolded? (A point on the edge leaves them
+/// in the old triangle's plane; one off it, on a crease (CreaseGuard::onto), tilts them.)
 bool split_point_ok(const TriMesh& mesh, EdgeHandle e, const Vec3& p) {
   for (int s = 0; s < 2; ++s) {
     const HalfedgeHandle h = mesh.halfedge_handle(e, s);
@@ -54,6 +55,9 @@ bool split_point_ok(const TriMesh& mesh, EdgeHandle e, const Vec3& p) {
     const Vec3& c = mesh.point(mesh.to_vertex_handle(mesh.next_halfedge_handle(h)));
     geom::AngleFloor floor([&] { return geom::min_angle(a, b, c); }, kSplitAngleSlack);
     if (floor.breaks(a, p, c) || floor.breaks(p, b, c)) return false;
+    const Vec3 before = geom::cross_normal(a, b, c);
+    if (!geom::normals_agree(before, geom::cross_normal(a, p, c)) || !geom::normals_agree(before, geom::cross_normal(p, b, c)))
+      return false;
   }
   return true;
 }
@@ -66,7 +70,7 @@ VertexHandle split_edge(TriMesh& mesh, EdgeHandle e, double target, const Crease
   const Vec3 a = mesh.point(v0), b = mesh.point(mesh.to_vertex_handle(h));
   const double t = equalizing_parameter(a, b, split_neighbours(mesh, e), target);
   // An edge along a crease: its points go onto the crease (the chord of a bent one sags below it).
-  const bool crease = creases && creases->along(a, b);
+  const bool crease = creases && creases->along(mesh, e);
   auto placed = [&](const Vec3& q) { return crease ? creases->onto(q, a, b) : q; };
   Vec3 p = placed(a + (b - a) * t);
   if (!split_point_ok(mesh, e, p)) {
@@ -144,7 +148,7 @@ int crease_collapse(const TriMesh& mesh, HalfedgeHandle& h, const CreaseGuard& c
   const CreaseLines::Kind k0 = creases.locate(a).kind, k1 = creases.locate(b).kind;
   using Kind = CreaseLines::Kind;
   if (k0 == Kind::None && k1 == Kind::None) return 0;
-  const bool along = k0 != Kind::None && k1 != Kind::None && creases.along(a, b);
+  const bool along = k0 != Kind::None && k1 != Kind::None && creases.along(mesh, mesh.edge_handle(h));
   if (k0 != Kind::None && k1 != Kind::None && !along) return -1;  // across: would join two creases
   if (along && k0 == Kind::Corner && k1 == Kind::Corner) return -1;
   // The end that stays: the one on a crease (not along), or the corner (along).

@@ -33,7 +33,7 @@ bool flip_is_safe(const TriMesh& mesh, EdgeHandle e, double f, const VertexInfo*
                   const CreaseGuard* creases) {
   if (mesh.status(e).deleted() || mesh.is_boundary(e) || !mesh.is_flip_ok(e)) return false;
   const Quad q = quad_of(mesh, e);
-  if (creases && creases->along(mesh.point(q.v0), mesh.point(q.v1))) return false;
+  if (creases && creases->along(mesh, e)) return false;
   // The ends lose an edge: keep interior valence >= 3 and boundary valence >= 2.
   for (VertexHandle v : {q.v0, q.v1}) {
     const bool boundary = info ? info->boundary[v.idx()] != 0 : mesh.is_boundary(v);

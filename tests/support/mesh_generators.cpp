@@ -125,6 +125,27 @@ TriMesh make_sliver_cylinder(int segments, double radius, double height) {
   return m;
 }
 
+TriMesh make_rim_fanned_cylinder(int segments, double radius, double height) {
+  TriMesh m;
+  std::vector<VH> lo, hi;
+  for (int i = 0; i < segments; ++i) {
+    const double a = 2 * M_PI * i / segments;
+    lo.push_back(m.add_vertex(Vec3(radius * std::cos(a), radius * std::sin(a), 0)));
+    hi.push_back(m.add_vertex(Vec3(radius * std::cos(a), radius * std::sin(a), height)));
+  }
+  for (int i = 0; i < segments; ++i) {
+    const int j = (i + 1) % segments;
+    add_tri(m, lo[i], lo[j], hi[j]);
+    add_tri(m, lo[i], hi[j], hi[i]);
+  }
+  for (int i = 1; i + 1 < segments; ++i) {
+    add_tri(m, lo[0], lo[i + 1], lo[i]);
+    add_tri(m, hi[0], hi[i], hi[i + 1]);
+  }
+  m.update_normals();
+  return m;
+}
+
 TriMesh make_hex_lattice_patch(int rows, int cols, double spacing) {
   TriMesh m;
   std::vector<VH> vh;

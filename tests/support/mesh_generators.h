@@ -30,6 +30,9 @@ TriMesh make_fan(int sectors, double radius);
 /// Closed cylinder (axis z, from 0 to `height`) as CAD exports write it: `segments` flat side facets,
 /// each two slivers from rim to rim, and caps that are fans around a centre vertex.
 TriMesh make_sliver_cylinder(int segments, double radius, double height);
+/// The same side (without its axis vertices), its caps fans from the rim vertex at angle 0 (as
+/// CAD exports write them): the caps' chords join two points of a rim.
+TriMesh make_rim_fanned_cylinder(int segments, double radius, double height);
 
 /// Empty if `mesh` is valid: no deleted elements left, every vertex manifold, every face a
 /// non-degenerate triangle (area > area_eps * mean area), no folded pair of adjacent triangles

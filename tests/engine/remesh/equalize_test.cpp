@@ -400,6 +400,21 @@ TEST_CASE("keep_creases keeps a box's edges and a cylinder's rims in the surface
       else CHECK(edges > 1e-6);
     }
   }
+  SECTION("a cylinder whose caps are fans from a rim vertex: the chords across a cap stay free") {
+    // Counted as crease edges (a crease joins their ends), they could not be flipped and their
+    // splits went onto the rim: 60.7 % inside, thousands of faces folded over.
+    TriMesh mesh = test::make_rim_fanned_cylinder(64, 1.0, 2.0);
+    const TriMesh input = mesh;
+    Params p;
+    p.e_min = 0.08;
+    p.e_max = 0.12;
+    p.keep_creases = true;
+    remesh_and_check(mesh, p);
+    CHECK(test::plain_inside_fraction(mesh, p.e_min, p.e_max) >= 0.995);
+    double farthest = 0;
+    for (auto v : mesh.vertices()) farthest = std::max(farthest, test::brute_distance(input, mesh.point(v)));
+    CHECK(farthest < 1e-9);
+  }
   SECTION("a cylinder given as slivers with fan caps: the rims within the sag of an edge") {
     // Kept, a rim is a polyline through points of the input's rim: an edge of at most e_max cuts
     // the input's (128 segments) by at most e_max^2 / 8 = 0.0018. Followed only: 0.046.
@@ -444,9 +459,11 @@ TEST_CASE("the returned mesh's normals are those of its faces", "[equalize]") {
       CHECK(mesh.normal(f).norm() == Approx(1.0).epsilon(1e-9));
       CHECK((mesh.normal(f) | n) > 1.0 - 1e-9);
     }
+    // Each vertex's normal as OpenMesh computes it from the returned faces (the area-weighted
+    // geom::vertex_normal differs by up to 40 degrees where a star wraps around the thin torus).
     for (auto v : mesh.vertices()) {
       CHECK(mesh.normal(v).norm() == Approx(1.0).epsilon(1e-9));
-      CHECK((mesh.normal(v) | geom::vertex_normal(mesh, v)) > 0.9);
+      CHECK((mesh.normal(v) | Vec3(mesh.calc_vertex_normal(v)).normalized()) > 1.0 - 1e-9);
     }
   }
 }

@@ -665,6 +665,57 @@ TEST_CASE("project_vertices puts the placed vertices on the reference, the other
   CHECK(test::check_mesh_valid(mesh) == "");
 }
 
+TEST_CASE("the interval guard projects every vertex it leaves half way, moved once or more", "[steps]") {
+  // A vertex moved tangentially off a sphere breaks its edges; the guard moves it back half way
+  // (twice in one round when two of its edges broke) and then onto the reference. Before, a vertex
+  // moved twice in its first round was left a quarter of the way back, 2.1e-3 off the sphere.
+  const TriMesh sphere = test::make_icosphere(3, 1.0);
+  const ReferenceSurface reference(sphere);
+  double lo = 1e9, hi = 0;
+  for (auto e : sphere.edges()) lo = std::min(lo, sphere.calc_edge_length(e)), hi = std::max(hi, sphere.calc_edge_length(e));
+  for (const double share : {0.3, 0.6, 1.2}) {
+    TriMesh mesh = sphere;
+    const std::vector<Vec3> before = snapshot_points(mesh);
+    const auto v = mesh.vertex_handle(0);
+    const Vec3 n = mesh.point(v).normalized();
+    Vec3 t = Vec3(0, 0, 1) % n;
+    if (t.norm() < 1e-6) t = Vec3(1, 0, 0) % n;
+    mesh.point(v) += t.normalized() * (share * hi);
+    INFO("moved by " << share << " of the longest edge");
+    REQUIRE(undo_interval_breaks(mesh, before, 0.8 * lo, 1.25 * hi, 3, &reference) > 0);
+    CHECK((reference.closest_point(mesh.point(v)) - mesh.point(v)).norm() < 1e-12);
+    CHECK(test::plain_inside_fraction(mesh, 0.8 * lo, 1.25 * hi) == 1.0);
+  }
+}
+
+TEST_CASE("a chord across a flat cap is no crease edge, though a crease joins its ends", "[steps]") {
+  // A cylinder whose caps are fans from a rim vertex (as CAD exports write them): the cap's chords
+  // join two rim points, a crease of 90 degrees or less joins them, but the chord's faces are flat.
+  const int n = 64;
+  const TriMesh mesh = test::make_rim_fanned_cylinder(n, 1.0, 2.0);
+  auto rim = [&](int i) {  // vertex i of the bottom rim (the generator adds them bottom, top, bottom, ...)
+    return mesh.vertex_handle(static_cast<unsigned>(2 * i));
+  };
+  const CreaseLines creases(mesh);
+  REQUIRE(creases.size() == 2 * n);
+  const CreaseGuard guard(creases, 1e-9);
+  const auto chord = edge_between(mesh, mesh.point(rim(0)), mesh.point(rim(16)));
+  const auto along_rim = edge_between(mesh, mesh.point(rim(0)), mesh.point(rim(1)));
+  REQUIRE(chord.is_valid());
+  REQUIRE(along_rim.is_valid());
+  CHECK(guard.along(mesh.point(rim(0)), mesh.point(rim(16))));  // a quarter of the rim joins them
+  CHECK_FALSE(guard.along(mesh, chord));
+  CHECK(guard.along(mesh, along_rim));
+  // Flippable, and a split keeps its point on the chord.
+  CHECK(flip_is_safe(mesh, chord, 0.0, nullptr, false, &guard));
+  TriMesh split = mesh;
+  const auto v = split_edge(split, edge_between(split, split.point(rim(0)), split.point(rim(16))), 0.1, &guard);
+  REQUIRE(v.is_valid());
+  CHECK(std::abs(split.point(v)[2]) < 1e-12);
+  CHECK(std::hypot(split.point(v)[0], split.point(v)[1]) < 0.9);
+  CHECK(test::check_mesh_valid(split) == "");
+}
+
 TEST_CASE("the interval guard moves back, half way at a time, what took edges out of the interval", "[steps]") {
   // Every edge 1.5, inside [1.2, 1.8]; a random move of up to 0.35 per coordinate takes many out.
   for (const int halvings : {0, 3}) {
