@@ -41,10 +41,10 @@ struct Params {
   /// vertex on a crease slides along it only until the interval cleanup starts, and the creases
   /// come out slightly bevelled. Measured (Table 4.2 setup, means over the five intervals of bench
   /// --spread; inside %, Hausdorff % of the bbox diagonal, off -> on): fandisk refined 100 / 0.533
-  /// -> 99.969 / 0.250, simplified 100 / 1.704 -> 99.448 / 0.718; cheese refined 99.65 / 2.91 ->
-  /// 96.17 / 1.54 (its hole rims have corners closer together than e_min, and walls thinner than
+  /// -> 99.969 / 0.250, simplified 100 / 1.704 -> 99.492 / 0.770; cheese refined 99.66 / 2.88 ->
+  /// 95.81 / 1.55 (its hole rims have corners closer together than e_min, and walls thinner than
   /// e_min between two creases: a third of the edges left outside are short edges between crease
-  /// points, which no collapse may merge), cow refined 99.91 / 1.16 -> 99.79 / 1.26.
+  /// points, which no collapse may merge), cow refined 99.91 / 1.19 -> 99.79 / 1.27.
   bool keep_creases = false;
 };
 
