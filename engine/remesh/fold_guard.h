@@ -23,10 +23,11 @@ std::size_t undo_folds(TriMesh& mesh, const std::vector<Vec3>& before, unsigned 
 /// Not in the thesis: the same net for the interval, used once the interval cleanup has taken over
 /// (equalize.cpp, kSteadyAfter). Every edge that was inside [e_min, e_max] at `before` and is not
 /// now gets both ends moved half way back to `before` (`halvings` times at most, then all the way),
-/// repeatedly until no such edge is left. Returns the number of moves back. With `reference`, a
-/// point half way back is projected onto it: between two points of a curved surface the midpoint
-/// lies under it (a cylinder of radius 1 at [0.08, 0.12]: 16 vertices up to 7.8e-5 off its surface),
-/// through the vertices' kd-tree answers in `caches` (by vertex index, projection.h) when given.
+/// repeatedly until no such edge is left. Returns the number of moves back. With `reference`, each
+/// vertex left part of the way back is then projected onto it (project_vertex, through its kd-tree
+/// answer in `caches`, by vertex index, when given), and goes all the way back if that takes an edge
+/// out of the interval: between two points of a curved surface the midpoint lies under it (a
+/// cylinder of radius 1 at [0.08, 0.12]: 16 vertices up to 7.8e-5 off its surface).
 std::size_t undo_interval_breaks(TriMesh& mesh, const std::vector<Vec3>& before, double e_min, double e_max,
                                  int halvings = 3, const ReferenceSurface* reference = nullptr,
                                  std::vector<NeighbourCache>* caches = nullptr);
