@@ -105,10 +105,12 @@ TriMesh make_fan(int sectors, double radius) {
   return m;
 }
 
-TriMesh make_sliver_cylinder(int segments, double radius, double height) {
-  TriMesh m;
-  const VH bottom = m.add_vertex(Vec3(0, 0, 0)), top = m.add_vertex(Vec3(0, 0, height));
-  std::vector<VH> lo, hi;
+namespace {
+
+/// A cylinder's side as one row of slivers from rim to rim: its rim vertices (bottom and top,
+/// added in turn) into `lo` and `hi`.
+void add_sliver_side(TriMesh& m, int segments, double radius, double height, std::vector<VH>& lo,
+                     std::vector<VH>& hi) {
   for (int i = 0; i < segments; ++i) {
     const double a = 2 * M_PI * i / segments;
     lo.push_back(m.add_vertex(Vec3(radius * std::cos(a), radius * std::sin(a), 0)));
@@ -116,10 +118,22 @@ TriMesh make_sliver_cylinder(int segments, double radius, double height) {
   }
   for (int i = 0; i < segments; ++i) {
     const int j = (i + 1) % segments;
-    add_tri(m, bottom, lo[j], lo[i]);
-    add_tri(m, top, hi[i], hi[j]);
     add_tri(m, lo[i], lo[j], hi[j]);
     add_tri(m, lo[i], hi[j], hi[i]);
+  }
+}
+
+}  // namespace
+
+TriMesh make_sliver_cylinder(int segments, double radius, double height) {
+  TriMesh m;
+  const VH bottom = m.add_vertex(Vec3(0, 0, 0)), top = m.add_vertex(Vec3(0, 0, height));
+  std::vector<VH> lo, hi;
+  add_sliver_side(m, segments, radius, height, lo, hi);
+  for (int i = 0; i < segments; ++i) {
+    const int j = (i + 1) % segments;
+    add_tri(m, bottom, lo[j], lo[i]);
+    add_tri(m, top, hi[i], hi[j]);
   }
   m.update_normals();
   return m;
@@ -128,16 +142,7 @@ TriMesh make_sliver_cylinder(int segments, double radius, double height) {
 TriMesh make_rim_fanned_cylinder(int segments, double radius, double height) {
   TriMesh m;
   std::vector<VH> lo, hi;
-  for (int i = 0; i < segments; ++i) {
-    const double a = 2 * M_PI * i / segments;
-    lo.push_back(m.add_vertex(Vec3(radius * std::cos(a), radius * std::sin(a), 0)));
-    hi.push_back(m.add_vertex(Vec3(radius * std::cos(a), radius * std::sin(a), height)));
-  }
-  for (int i = 0; i < segments; ++i) {
-    const int j = (i + 1) % segments;
-    add_tri(m, lo[i], lo[j], hi[j]);
-    add_tri(m, lo[i], hi[j], hi[i]);
-  }
+  add_sliver_side(m, segments, radius, height, lo, hi);
   for (int i = 1; i + 1 < segments; ++i) {
     add_tri(m, lo[0], lo[i + 1], lo[i]);
     add_tri(m, hi[0], hi[i], hi[i + 1]);

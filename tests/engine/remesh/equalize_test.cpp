@@ -22,6 +22,22 @@ using namespace remesh;
 
 namespace {
 
+/// The interval [e_min, e_max], the other parameters their defaults but keep_creases.
+Params interval(double e_min, double e_max, bool keep_creases = false) {
+  Params p;
+  p.e_min = e_min;
+  p.e_max = e_max;
+  p.keep_creases = keep_creases;
+  return p;
+}
+
+/// The largest distance from a vertex of `mesh` to the surface of `input`.
+double farthest_vertex(const TriMesh& input, const TriMesh& mesh) {
+  double farthest = 0;
+  for (auto v : mesh.vertices()) farthest = std::max(farthest, test::brute_distance(input, mesh.point(v)));
+  return farthest;
+}
+
 Params table_4_2(int iterations = 100) {
   Params p;
   p.e_min = 1.2;
@@ -322,9 +338,7 @@ TEST_CASE("a cylinder given as slivers with fan caps stays on its surface, near 
     INFO(segments << " segments, " << offset << " from the origin");
     remesh_and_check(mesh, p);
     CHECK(test::plain_inside_fraction(mesh, 0.08, 0.12) >= 0.995);
-    double farthest = 0;
-    for (auto v : mesh.vertices()) farthest = std::max(farthest, test::brute_distance(input, mesh.point(v)));
-    CHECK(farthest < (offset > 0 ? 1e-6 : 1e-9));  // 1e8 has a last bit of 1.5e-8
+    CHECK(farthest_vertex(input, mesh) < (offset > 0 ? 1e-6 : 1e-9));  // 1e8 has a last bit of 1.5e-8
     double rim = 0;
     for (auto v : input.vertices())
       if (std::abs(std::hypot(input.point(v)[0] - offset, input.point(v)[1] - offset) - 1) < 1e-6)
@@ -383,16 +397,11 @@ TEST_CASE("keep_creases keeps a box's edges and a cylinder's rims in the surface
     for (const bool keep : {false, true}) {
       TriMesh mesh = make_box(6);
       const TriMesh input = mesh;
-      Params p;
-      p.e_min = 0.8;
-      p.e_max = 1.2;
-      p.keep_creases = keep;
+      const Params p = interval(0.8, 1.2, keep);
       INFO("keep_creases " << keep);
       remesh_and_check(mesh, p);
       CHECK(test::plain_inside_fraction(mesh, p.e_min, p.e_max) >= 0.995);
-      double farthest = 0;
-      for (auto v : mesh.vertices()) farthest = std::max(farthest, test::brute_distance(input, mesh.point(v)));
-      CHECK(farthest < 1e-9);
+      CHECK(farthest_vertex(input, mesh) < 1e-9);
       // Without: vertices on an edge move off it with every collapse and flip of the edges along it
       // (and cuts it by more than 1e-6).
       const double edges = box_edges_distance(mesh, 6);
@@ -405,15 +414,10 @@ TEST_CASE("keep_creases keeps a box's edges and a cylinder's rims in the surface
     // splits went onto the rim: 60.7 % inside, thousands of faces folded over.
     TriMesh mesh = test::make_rim_fanned_cylinder(64, 1.0, 2.0);
     const TriMesh input = mesh;
-    Params p;
-    p.e_min = 0.08;
-    p.e_max = 0.12;
-    p.keep_creases = true;
+    const Params p = interval(0.08, 0.12, true);
     remesh_and_check(mesh, p);
     CHECK(test::plain_inside_fraction(mesh, p.e_min, p.e_max) >= 0.995);
-    double farthest = 0;
-    for (auto v : mesh.vertices()) farthest = std::max(farthest, test::brute_distance(input, mesh.point(v)));
-    CHECK(farthest < 1e-9);
+    CHECK(farthest_vertex(input, mesh) < 1e-9);
   }
   SECTION("a cylinder given as slivers with fan caps: the rims within the sag of an edge") {
     // Kept, a rim is a polyline through points of the input's rim: an edge of at most e_max cuts
@@ -421,10 +425,7 @@ TEST_CASE("keep_creases keeps a box's edges and a cylinder's rims in the surface
     for (const bool keep : {false, true}) {
       TriMesh mesh = test::make_sliver_cylinder(128, 1.0, 2.0);
       const TriMesh input = mesh;
-      Params p;
-      p.e_min = 0.08;
-      p.e_max = 0.12;
-      p.keep_creases = keep;
+      const Params p = interval(0.08, 0.12, keep);
       INFO("keep_creases " << keep);
       remesh_and_check(mesh, p);
       CHECK(test::plain_inside_fraction(mesh, p.e_min, p.e_max) >= 0.995);
