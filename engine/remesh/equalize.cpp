@@ -547,7 +547,7 @@ Result equalize(TriMesh& mesh, const Params& requested, const OnIteration& on_it
       // in the returned mesh; after this, 0.06 in the iterations). Before the flips, which see the
       // projected points: after them, the Hausdorff distances came out between and cheese's
       // simplification crossed more. Measured: bench/README.md, "Vertices kept on the surface".
-      project_vertices(mesh, placed, *reference);
+      project_vertices(mesh, placed, *reference, threads, &neighbour_caches);
       collect_garbage(mesh);
       renumbered_since += stellar.splits + stellar.collapses;
       if (mesh.n_vertices() >= kOrderMinVertices &&

@@ -14,14 +14,43 @@ Vec3 project_vertex(const TriMesh& mesh, OpenMesh::VertexHandle v, const Vec3& p
   return cache ? reference.closest_point(p, normal, *cache) : reference.closest_point(p, normal);
 }
 
+namespace {
+
+/// The kd-tree answer a placed vertex's search starts from (project_vertices): its own, else the
+/// first neighbour's that has one, else none. Any cache gives exact answers (reference_surface.h);
+/// a neighbour's, one edge away, mostly answers without the kd-tree.
+NeighbourCache seed_cache(const TriMesh& mesh, OpenMesh::VertexHandle v, const std::vector<NeighbourCache>* caches) {
+  if (!caches) return {};
+  auto filled = [&](OpenMesh::VertexHandle u) {
+    return static_cast<std::size_t>(u.idx()) < caches->size() && (*caches)[u.idx()].surface != 0;
+  };
+  if (filled(v)) return (*caches)[v.idx()];
+  for (auto w : mesh.vv_range(v))
+    if (filled(w)) return (*caches)[w.idx()];
+  return {};
+}
+
+}  // namespace
+
 std::size_t project_vertices(TriMesh& mesh, const std::vector<OpenMesh::VertexHandle>& vertices,
-                             const ReferenceSurface& reference) {
+                             const ReferenceSurface& reference, unsigned threads,
+                             const std::vector<NeighbourCache>* caches) {
+  auto live = [&](OpenMesh::VertexHandle v) { return !mesh.status(v).deleted() && !mesh.is_isolated(v); };
+  std::vector<Vec3> target(vertices.size());
+  parallel_for(
+      vertices.size(), threads,
+      [&](std::size_t k) {
+        const auto v = vertices[k];
+        if (!live(v)) return;
+        NeighbourCache cache = seed_cache(mesh, v, caches);
+        target[k] = project_vertex(mesh, v, mesh.point(v), geom::vertex_normal(mesh, v), reference, &cache);
+      },
+      /*block=*/64);
   std::size_t moved = 0;
-  for (auto v : vertices) {
-    if (mesh.status(v).deleted() || mesh.is_isolated(v)) continue;
-    const Vec3 p = project_vertex(mesh, v, mesh.point(v), geom::vertex_normal(mesh, v), reference);
-    if (p == mesh.point(v) || !geom::move_is_safe(mesh, v, p)) continue;
-    mesh.point(v) = p;
+  for (std::size_t k = 0; k < vertices.size(); ++k) {
+    const auto v = vertices[k];
+    if (!live(v) || target[k] == mesh.point(v) || !geom::move_is_safe(mesh, v, target[k])) continue;
+    mesh.point(v) = target[k];
     ++moved;
   }
   return moved;

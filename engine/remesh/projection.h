@@ -21,11 +21,14 @@ double project_onto_reference(TriMesh& mesh, const ReferenceSurface& reference, 
                               std::vector<NeighbourCache>* caches = nullptr);
 
 /// Projects the given vertices (live ones; the others are passed over) onto `reference`, each
-/// only where the move folds nothing (geom::move_is_safe), one after the other. Returns how many
-/// moved.
+/// only where the move folds nothing (geom::move_is_safe). The targets are found in parallel, each
+/// from the mesh as it is on entry (so the result is the same whatever the thread count), then the
+/// moves are checked and made one after the other, in the order given. With `caches` (indexed by
+/// vertex, as project_onto_reference keeps them; not written), a vertex's search starts from its
+/// own cache or, for a vertex without one (a split's), from a neighbour's. Returns how many moved.
 std::size_t project_vertices(TriMesh& mesh, const std::vector<OpenMesh::VertexHandle>& vertices,
-                             const ReferenceSurface& reference);
-
+                             const ReferenceSurface& reference, unsigned threads = 1,
+                             const std::vector<NeighbourCache>* caches = nullptr);
 /// The position one vertex would take: closest_boundary_point for boundary vertices, else
 /// closest_point with `normal` as the hint (through `cache` when given).
 Vec3 project_vertex(const TriMesh& mesh, OpenMesh::VertexHandle v, const Vec3& p, const Vec3& normal,

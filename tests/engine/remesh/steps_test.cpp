@@ -659,10 +659,21 @@ TEST_CASE("project_vertices puts the placed vertices on the reference, the other
     if (v.idx() % 7 == 0) mesh.point(v) *= 0.98, placed.push_back(v);
   const OpenMesh::VertexHandle other = mesh.vertex_handle(1);
   mesh.point(other) *= 0.98;  // pushed too, but not placed
+  TriMesh twin = mesh;
   CHECK(project_vertices(mesh, placed, surface) == placed.size());
   for (auto v : placed) CHECK(test::brute_distance(reference, mesh.point(v)) < 1e-9);
   CHECK(test::brute_distance(reference, mesh.point(other)) > 0.1);
   CHECK(test::check_mesh_valid(mesh) == "");
+  // With the iterations' kd-tree answers (filled by a projection of another mesh, so that every
+  // vertex's search starts from a cache or a neighbour's, none of them this point's) and two
+  // threads: the same points.
+  std::vector<NeighbourCache> caches;
+  TriMesh projected = reference;
+  for (auto v : projected.vertices()) projected.point(v) *= 1.01;
+  project_onto_reference(projected, surface, 1, &caches);
+  caches.resize(caches.size() / 2);  // the upper half of the vertices take a neighbour's
+  CHECK(project_vertices(twin, placed, surface, 2, &caches) == placed.size());
+  for (auto v : twin.vertices()) CHECK((twin.point(v) - mesh.point(v)).norm() < 1e-12);
 }
 
 TEST_CASE("the interval guard projects every vertex it leaves half way, moved once or more", "[steps]") {
