@@ -37,7 +37,8 @@ struct Params {
   /// Not in the thesis: the reference's creases (crease_lines.h: edges over 75 degrees, in lines
   /// of 10 or more) stay in the surface exactly, as its boundary does (CreaseGuard): vertices on
   /// them move along them only, their edges are not flipped, splits and collapses put their
-  /// vertex on them, and an edge between two creases is not collapsed. For CAD models; off, a
+  /// vertex on them, and an edge between two creases is not collapsed; the untangling follows the
+  /// rule too, and breaks it only for the crossings it cannot mend otherwise. For CAD models; off, a
   /// vertex on a crease slides along it only until the interval cleanup starts, and the creases
   /// come out slightly bevelled. Measured (Table 4.2 setup, means over the five intervals of bench
   /// --spread; inside %, Hausdorff % of the bbox diagonal, off -> on): fandisk refined 100 / 0.533

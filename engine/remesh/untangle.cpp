@@ -117,8 +117,8 @@ struct Disk {
 
 class Untangler {
  public:
-  Untangler(TriMesh& mesh, const ReferenceSurface& reference, double e_min, double e_max)
-      : mesh_(mesh), reference_(reference), e_min_(e_min), e_max_(e_max),
+  Untangler(TriMesh& mesh, const ReferenceSurface& reference, double e_min, double e_max, const CreaseGuard* creases)
+      : mesh_(mesh), reference_(reference), e_min_(e_min), e_max_(e_max), creases_(creases),
         vertex_mark_(mesh.n_vertices(), 0), face_mark_(mesh.n_faces(), 0) {}
 
   /// One round of vertex moves over the vertices of `pairs`; returns the moves kept. A vertex whose
@@ -218,7 +218,7 @@ class Untangler {
   /// it, so only the sum bounds how far it is from where the index saw it (flip_round indexes
   /// the faces anew after a round that kept a flip, which sets drift_ back to 0).
   bool try_flip(OpenMesh::EdgeHandle e) {
-    if (!flip_is_safe(mesh_, e, 0.0, nullptr, /*turned_ok=*/true)) return false;
+    if (!flip_is_safe(mesh_, e, 0.0, nullptr, /*turned_ok=*/true, creases_)) return false;
     const Quad q = quad_of(mesh_, e);
     const Vec3 p[4] = {mesh_.point(q.v0), mesh_.point(q.v1), mesh_.point(q.v2), mesh_.point(q.v3)};
     if (outside((p[3] - p[2]).norm()) && !outside((p[1] - p[0]).norm())) return false;
@@ -291,16 +291,21 @@ class Untangler {
     }
     const Vec3 centroid = ring_centroid(mesh_, v);
     const Vec3 normal = geom::vertex_normal(mesh_, v);
-    // On the reference first (the surface stays the input's), else where the ring puts it.
+    // On the reference first (the surface stays the input's), else where the ring puts it; a
+    // vertex on a crease along it only (CreaseGuard::constrain: a corner stays).
+    const CreaseLines::Where where = creases_ ? creases_->locate(start) : CreaseLines::Where{};
     std::vector<Vec3> candidates;
     double radius = reach;
     for (double s : kSteps) {
       const Vec3 target = start + s * (centroid - start);
-      for (const Vec3& p : {project_vertex(mesh_, v, target, normal, reference_), target}) {
-        candidates.push_back(p);
-        radius = std::max(radius, (p - start).norm());
+      if (where.kind != CreaseLines::Kind::None) {
+        candidates.push_back(CreaseGuard::constrain(start, where, target));
+      } else {
+        candidates.push_back(project_vertex(mesh_, v, target, normal, reference_));
+        candidates.push_back(target);
       }
     }
+    for (const Vec3& p : candidates) radius = std::max(radius, (p - start).norm());
     if (radius > reach) faces_near(start, radius, near);
     // Should every move fail: what it read lies within `radius` of start, plus one edge (the faces
     // across the ring's edges that move_is_safe reads).
@@ -348,7 +353,7 @@ class Untangler {
       begin = end;
     }
     for (auto v : disk.inner) {
-      if (mesh_.is_boundary(v)) return std::nullopt;
+      if (mesh_.is_boundary(v) || (creases_ && creases_->on(mesh_.point(v)))) return std::nullopt;
       for (auto f : mesh_.vf_range(v))
         if (face_mark_[f.idx()] != stamp) face_mark_[f.idx()] = stamp, disk.faces.push_back(f);
     }
@@ -535,6 +540,7 @@ class Untangler {
   std::unordered_map<int, Vec3> origins_;
   double drift_ = 0;
   double e_min_, e_max_;
+  const CreaseGuard* creases_;  ///< may be null (untangle's `creases`)
   std::vector<int> vertex_mark_, face_mark_;
   Box moves_;
   bool moved_ = false;
@@ -642,6 +648,14 @@ class CollapseJudge {
   std::vector<Triangle> now_, then_;
 };
 
+/// May the collapse of h (its from-vertex into its to-vertex, where that stands) keep the creases?
+/// A vertex off them may go, one on a crease line only into a vertex along it, a corner never.
+bool crease_keeps(const CreaseGuard& creases, const TriMesh& mesh, HalfedgeHandle h) {
+  const CreaseLines::Kind gone = creases.locate(mesh.point(mesh.from_vertex_handle(h))).kind;
+  if (gone == CreaseLines::Kind::None) return true;
+  return gone == CreaseLines::Kind::Line && creases.along(mesh, mesh.edge_handle(h));
+}
+
 /// Collapses edges of the crossing faces of `pairs`, one end onto the other where it stands, when
 /// that lowers the crossings of the two ends' faces and passes the rules of Algorithm 3's
 /// collapses (link condition, no interior edge between two boundary vertices, no boundary vertex
@@ -651,9 +665,10 @@ class CollapseJudge {
 /// leave short edges: the crossings sit where the surface is thinner than the interval allows (the
 /// edges there are short already). Measured (crossing face pairs, coarsened meshes): keeping the
 /// edges outside from growing left camelhead at 8 instead of 0; keeping tips (is_tip: in a tangle
-/// the spikes of crumpled faces) left armadillo at 15 instead of 6. Leaves deleted elements.
+/// the spikes of crumpled faces) left armadillo at 15 instead of 6. With `creases`, a vertex on a
+/// crease goes only into another along it, and a corner not at all. Leaves deleted elements.
 /// Returns the collapses.
-std::size_t collapse_round(TriMesh& mesh, double e_max, const Pairs& pairs) {
+std::size_t collapse_round(TriMesh& mesh, double e_max, const Pairs& pairs, const CreaseGuard* creases) {
   CollapseJudge judge(mesh);
   std::size_t kept = 0;
   for (auto e : edges_of(mesh, pairs)) {
@@ -666,6 +681,7 @@ std::size_t collapse_round(TriMesh& mesh, double e_max, const Pairs& pairs) {
     for (const HalfedgeHandle h : {h0, mesh.opposite_halfedge_handle(h0)}) {
       const VertexHandle gone = mesh.from_vertex_handle(h), stays = mesh.to_vertex_handle(h);
       if (mesh.is_boundary(gone) || !mesh.is_collapse_ok(h)) continue;
+      if (creases && !crease_keeps(*creases, mesh, h)) continue;
       const Vec3 at = mesh.point(stays);
       if (!collapse_geometry_ok(mesh, h, at, e_max, /*turned_ok=*/true)) continue;
       const auto [before, after] = judge.crossings(h);
@@ -683,12 +699,12 @@ std::size_t collapse_round(TriMesh& mesh, double e_max, const Pairs& pairs) {
 }  // namespace
 
 UntangleCounts untangle(TriMesh& mesh, const ReferenceSurface& reference, double e_min, double e_max,
-                        unsigned threads) {
+                        unsigned threads, const CreaseGuard* creases) {
   UntangleCounts counts;
   Pairs pairs = find_self_intersections(mesh, threads);
   counts.pairs_before = pairs.size();
   if (pairs.empty()) return counts;
-  std::optional<Untangler> untangler(std::in_place, mesh, reference, e_min, e_max);
+  std::optional<Untangler> untangler(std::in_place, mesh, reference, e_min, e_max, creases);
   auto move_rounds = [&] {
     for (int r = 0; r < kMoveRounds && !pairs.empty(); ++r) {
       const std::size_t kept = untangler->move_round(pairs);
@@ -710,13 +726,13 @@ UntangleCounts untangle(TriMesh& mesh, const ReferenceSurface& reference, double
       move_rounds();
     }
     if (pairs.empty()) break;
-    const std::size_t collapsed = collapse_round(mesh, e_max, pairs);
+    const std::size_t collapsed = collapse_round(mesh, e_max, pairs, creases);
     if (collapsed > 0) {
       counts.moved += collapsed;
       counts.collapsed += collapsed;
       collect_garbage(mesh);
       pairs = find_self_intersections(mesh, threads);
-      untangler.emplace(mesh, reference, e_min, e_max);
+      untangler.emplace(mesh, reference, e_min, e_max, creases);
       move_rounds();
     }
     if (pairs.size() >= at_start) break;

@@ -36,6 +36,7 @@
 #include <vector>
 
 #include "core/mesh.h"
+#include "remesh/crease_lines.h"
 #include "remesh/reference_surface.h"
 
 namespace remesh {
@@ -55,7 +56,11 @@ struct UntangleCounts {
 /// do not change. No vertex move folds a face; flips and collapses may turn faces that are turned
 /// already in the tangle (their normals need not agree with the old ones), but never make a pair
 /// of adjacent faces sharper than geom::adjacent_ok allows.
+/// With `creases` (Params::keep_creases: the CreaseGuard's rule, crease_lines.h), a vertex on a
+/// crease moves only along it and a corner not at all, an edge along a crease is never flipped, a
+/// vertex on a crease is collapsed only along it into another, and no flattened disk moves a crease
+/// vertex: the creases stay as the run kept them.
 UntangleCounts untangle(TriMesh& mesh, const ReferenceSurface& reference, double e_min, double e_max,
-                        unsigned threads);
+                        unsigned threads, const CreaseGuard* creases = nullptr);
 
 }  // namespace remesh

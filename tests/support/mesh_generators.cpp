@@ -92,6 +92,31 @@ TriMesh make_open_grid(int nx, int ny, double spacing) {
   return m;
 }
 
+TriMesh make_box(int n) {
+  TriMesh mesh;
+  std::map<std::array<int, 3>, OpenMesh::VertexHandle> at;
+  auto vertex = [&](std::array<int, 3> c) {
+    auto it = at.find(c);
+    if (it != at.end()) return it->second;
+    return at[c] = mesh.add_vertex(Vec3(c[0], c[1], c[2]));
+  };
+  for (int axis = 0; axis < 3; ++axis)
+    for (int side = 0; side < 2; ++side)
+      for (int i = 0; i < n; ++i)
+        for (int j = 0; j < n; ++j) {
+          const int u = (axis + 1) % 3, w = (axis + 2) % 3;
+          auto corner = [&](int di, int dj) {
+            std::array<int, 3> c{};
+            c[axis] = side * n, c[u] = i + di, c[w] = j + dj;
+            return vertex(c);
+          };
+          const auto a = corner(0, 0), b = corner(1, 0), c = corner(1, 1), d = corner(0, 1);
+          if (side == 1) mesh.add_face(a, b, c), mesh.add_face(a, c, d);
+          else mesh.add_face(a, c, b), mesh.add_face(a, d, c);
+        }
+  return mesh;
+}
+
 TriMesh make_fan(int sectors, double radius) {
   TriMesh m;
   const VH centre = m.add_vertex(Vec3(0, 0, 0));

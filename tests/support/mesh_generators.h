@@ -24,6 +24,9 @@ TriMesh make_hex_lattice_patch(int rows, int cols, double spacing);
 TriMesh make_plate_with_holes(int holes, double cell = 1.0, int sub = 2);
 /// Genus-2 closed surface (make_plate_with_holes(2, ...)).
 TriMesh make_double_torus(double cell = 1.0, int sub = 2);
+/// A box of n x n x n unit cells from the origin, its faces cut into cells of two triangles (its 12
+/// edges are creases of 90 degrees, its 8 corners where three meet).
+TriMesh make_box(int n);
 /// Flat disk of `radius` in z = 0 triangulated as a fan: `sectors` triangles around a centre vertex
 /// (a cap as CAD exports write it; above 360 sectors every triangle has an angle below 1 degree).
 TriMesh make_fan(int sectors, double radius);

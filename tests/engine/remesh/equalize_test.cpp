@@ -347,55 +347,10 @@ TEST_CASE("a cylinder given as slivers with fan caps stays on its surface, near 
   }
 }
 
-namespace {
-
-/// A box of n x n x n unit cells, its faces cut into cells of two triangles (its 12 edges are
-/// creases of 90 degrees, its 8 corners where three meet).
-TriMesh make_box(int n) {
-  TriMesh mesh;
-  std::map<std::array<int, 3>, OpenMesh::VertexHandle> at;
-  auto vertex = [&](std::array<int, 3> c) {
-    auto it = at.find(c);
-    if (it != at.end()) return it->second;
-    return at[c] = mesh.add_vertex(Vec3(c[0], c[1], c[2]));
-  };
-  for (int axis = 0; axis < 3; ++axis)
-    for (int side = 0; side < 2; ++side)
-      for (int i = 0; i < n; ++i)
-        for (int j = 0; j < n; ++j) {
-          const int u = (axis + 1) % 3, w = (axis + 2) % 3;
-          auto corner = [&](int di, int dj) {
-            std::array<int, 3> c{};
-            c[axis] = side * n, c[u] = i + di, c[w] = j + dj;
-            return vertex(c);
-          };
-          const auto a = corner(0, 0), b = corner(1, 0), c = corner(1, 1), d = corner(0, 1);
-          if (side == 1) mesh.add_face(a, b, c), mesh.add_face(a, c, d);
-          else mesh.add_face(a, c, b), mesh.add_face(a, d, c);
-        }
-  return mesh;
-}
-
-/// The largest distance from points along the box's 12 edges (every 0.05) to `mesh`.
-double box_edges_distance(const TriMesh& mesh, int n) {
-  double worst = 0;
-  for (int axis = 0; axis < 3; ++axis)
-    for (int a : {0, n})
-      for (int b : {0, n})
-        for (double t = 0; t <= n; t += 0.05) {
-          Vec3 p;
-          p[axis] = t, p[(axis + 1) % 3] = a, p[(axis + 2) % 3] = b;
-          worst = std::max(worst, test::brute_distance(mesh, p));
-        }
-  return worst;
-}
-
-}  // namespace
-
 TEST_CASE("keep_creases keeps a box's edges and a cylinder's rims in the surface", "[equalize]") {
   SECTION("a box: straight creases, kept exactly") {
     for (const bool keep : {false, true}) {
-      TriMesh mesh = make_box(6);
+      TriMesh mesh = test::make_box(6);
       const TriMesh input = mesh;
       const Params p = interval(0.8, 1.2, keep);
       INFO("keep_creases " << keep);
@@ -404,7 +359,7 @@ TEST_CASE("keep_creases keeps a box's edges and a cylinder's rims in the surface
       CHECK(farthest_vertex(input, mesh) < 1e-9);
       // Without: vertices on an edge move off it with every collapse and flip of the edges along it
       // (and cuts it by more than 1e-6).
-      const double edges = box_edges_distance(mesh, 6);
+      const double edges = test::box_edges_distance(mesh, 6);
       if (keep) CHECK(edges < 1e-9);
       else CHECK(edges > 1e-6);
     }

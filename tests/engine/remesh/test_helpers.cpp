@@ -44,4 +44,17 @@ double brute_distance(const TriMesh& mesh, const Vec3& p) {
   return best;
 }
 
+double box_edges_distance(const TriMesh& mesh, int n) {
+  double worst = 0;
+  for (int axis = 0; axis < 3; ++axis)
+    for (int a : {0, n})
+      for (int b : {0, n})
+        for (double t = 0; t <= n; t += 0.05) {
+          Vec3 p;
+          p[axis] = t, p[(axis + 1) % 3] = a, p[(axis + 2) % 3] = b;
+          worst = std::max(worst, brute_distance(mesh, p));
+        }
+  return worst;
+}
+
 }  // namespace remesh::test

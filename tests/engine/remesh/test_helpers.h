@@ -19,4 +19,8 @@ double plain_inside_fraction(const TriMesh& mesh, double lo, double hi);
 /// Distance from p to the nearest triangle of the mesh, by brute force over every face.
 double brute_distance(const TriMesh& mesh, const Vec3& p);
 
+/// The largest distance from points along the 12 edges of the box of make_box(n) (every 0.05) to
+/// `mesh` (brute_distance).
+double box_edges_distance(const TriMesh& mesh, int n);
+
 }  // namespace remesh::test

@@ -11,6 +11,7 @@
 #include <utility>
 #include <vector>
 
+#include "remesh/crease_lines.h"
 #include "remesh/geometry.h"
 #include "remesh/reference_surface.h"
 #include "remesh/self_intersections.h"
@@ -391,4 +392,45 @@ TEST_CASE("untangle's flips and collapses keep the topology and the boundary", "
   // Measured: flips were kept in 28 of the 40 draws (collapses in none: on this lattice the vertex
   // moves and flips mend what a collapse could; the finger test above has them).
   CHECK(flipped >= 10);
+}
+
+TEST_CASE("untangle with the crease guard leaves a box's edges where they are", "[untangle]") {
+  // A box of 12 unit cells, its 12 edges creases (crease_lines.h). Near the middle of one edge the
+  // vertices off the edges are crumpled: moved in their face's plane by up to 1.2 (across the
+  // edge, some of them) and in or out by up to 0.4, so that faces at the crease cross each other
+  // and the faces across it. The untangling moves the crease's own vertices too (they are corners
+  // of crossing faces): without the guard it takes the box's edge out of the surface, with it
+  // every point of the 12 edges stays on the mesh.
+  const int n = 12;
+  const TriMesh box = test::make_box(n);
+  const ReferenceSurface surface(box);
+  const CreaseLines lines(box);
+  REQUIRE_FALSE(lines.empty());
+  const CreaseGuard guard(lines, 1e-9);
+  const Vec3 centre(6, 0, 0);  // on the edge y = z = 0
+  int tangled = 0, cut_without = 0;
+  for (unsigned seed = 1; seed <= 16; ++seed) {
+    INFO("seed " << seed);
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<double> along(-1.2, 1.2), off(-0.4, 0.4);
+    TriMesh mesh = box;
+    for (auto v : mesh.vertices()) {
+      Vec3& p = mesh.point(v);
+      if ((p - centre).norm() > 2.5 || guard.on(p)) continue;
+      const int normal_axis = p[1] == 0 ? 1 : 2;  // the face y = 0 or z = 0
+      for (int axis = 0; axis < 3; ++axis) p[axis] += axis == normal_axis ? off(rng) : along(rng);
+    }
+    const std::size_t before = find_self_intersections(mesh, 1).size();
+    if (before == 0) continue;
+    ++tangled;
+    TriMesh unguarded = mesh;
+    const UntangleCounts counts = untangle(mesh, surface, 0.9, 1.5, 1, &guard);
+    CHECK(counts.pairs_before == before);
+    CHECK(test::box_edges_distance(mesh, n) < 1e-9);
+    CHECK(find_self_intersections(mesh, 1).size() <= before);
+    untangle(unguarded, surface, 0.9, 1.5, 1);
+    cut_without += test::box_edges_distance(unguarded, n) > 1e-3;
+  }
+  CHECK(tangled >= 8);
+  CHECK(cut_without > 0);  // the guard is what keeps the edges
 }
