@@ -24,8 +24,10 @@ double project_onto_reference(TriMesh& mesh, const ReferenceSurface& reference, 
 /// only where the move folds nothing (geom::move_is_safe). The targets are found in parallel, each
 /// from the mesh as it is on entry (so the result is the same whatever the thread count), then the
 /// moves are checked and made one after the other, in the order given. With `caches` (indexed by
-/// vertex, as project_onto_reference keeps them; not written), a vertex's search starts from its
-/// own cache or, for a vertex without one (a split's), from a neighbour's. Returns how many moved.
+/// vertex, as project_onto_reference keeps them; not written), a vertex's search starts from the
+/// cache at its index or, for a vertex without one (a split's), a neighbour's: after a garbage
+/// collection a slot may hold another vertex's answer, exact all the same, only less often
+/// reusable. Returns how many moved.
 std::size_t project_vertices(TriMesh& mesh, const std::vector<OpenMesh::VertexHandle>& vertices,
                              const ReferenceSurface& reference, unsigned threads = 1,
                              const std::vector<NeighbourCache>* caches = nullptr);

@@ -218,7 +218,13 @@ class Untangler {
   /// it, so only the sum bounds how far it is from where the index saw it (flip_round indexes
   /// the faces anew after a round that kept a flip, which sets drift_ back to 0).
   bool try_flip(OpenMesh::EdgeHandle e) {
-    if (!flip_is_safe(mesh_, e, 0.0, nullptr, /*turned_ok=*/true, creases_)) return false;
+    if (!flip_is_safe(mesh_, e, 0.0, nullptr, /*turned_ok=*/true)) return false;
+    // An edge whose ends a crease joins stays (CreaseGuard::along by the positions alone: in a
+    // tangle the two faces of a crease edge may be crumpled flat, and the guard's test of their
+    // angle would let it be flipped, cutting the crease).
+    if (creases_ && creases_->along(mesh_.point(mesh_.from_vertex_handle(mesh_.halfedge_handle(e, 0))),
+                                    mesh_.point(mesh_.to_vertex_handle(mesh_.halfedge_handle(e, 0)))))
+      return false;
     const Quad q = quad_of(mesh_, e);
     const Vec3 p[4] = {mesh_.point(q.v0), mesh_.point(q.v1), mesh_.point(q.v2), mesh_.point(q.v3)};
     if (outside((p[3] - p[2]).norm()) && !outside((p[1] - p[0]).norm())) return false;

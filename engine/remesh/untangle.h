@@ -59,7 +59,8 @@ struct UntangleCounts {
 /// With `creases` (Params::keep_creases: the CreaseGuard's rule, crease_lines.h), a vertex on a
 /// crease moves only along it and a corner not at all, an edge along a crease is never flipped, a
 /// vertex on a crease is collapsed only along it into another, and no flattened disk moves a crease
-/// vertex: the creases stay as the run kept them.
+/// vertex: the creases stay as the run kept them. (A flip is refused when a crease joins the edge's
+/// ends, CreaseGuard::along(a, b), whatever the angle of its faces: a tangle may crumple them flat.)
 UntangleCounts untangle(TriMesh& mesh, const ReferenceSurface& reference, double e_min, double e_max,
                         unsigned threads, const CreaseGuard* creases = nullptr);
 

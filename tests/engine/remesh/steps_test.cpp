@@ -672,8 +672,12 @@ TEST_CASE("project_vertices puts the placed vertices on the reference, the other
   for (auto v : projected.vertices()) projected.point(v) *= 1.01;
   project_onto_reference(projected, surface, 1, &caches);
   caches.resize(caches.size() / 2);  // the upper half of the vertices take a neighbour's
+  TriMesh single = twin;
   CHECK(project_vertices(twin, placed, surface, 2, &caches) == placed.size());
   for (auto v : twin.vertices()) CHECK((twin.point(v) - mesh.point(v)).norm() < 1e-12);
+  // The same caches on one thread: the same points, bit for bit.
+  CHECK(project_vertices(single, placed, surface, 1, &caches) == placed.size());
+  for (auto v : twin.vertices()) CHECK(twin.point(v) == single.point(v));
 }
 
 TEST_CASE("the interval guard projects every vertex it leaves half way, moved once or more", "[steps]") {

@@ -49,9 +49,9 @@ double box_edges_distance(const TriMesh& mesh, int n) {
   for (int axis = 0; axis < 3; ++axis)
     for (int a : {0, n})
       for (int b : {0, n})
-        for (double t = 0; t <= n; t += 0.05) {
+        for (int k = 0; k <= 20 * n; ++k) {
           Vec3 p;
-          p[axis] = t, p[(axis + 1) % 3] = a, p[(axis + 2) % 3] = b;
+          p[axis] = k / 20.0, p[(axis + 1) % 3] = a, p[(axis + 2) % 3] = b;
           worst = std::max(worst, brute_distance(mesh, p));
         }
   return worst;

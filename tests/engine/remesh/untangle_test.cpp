@@ -396,11 +396,12 @@ TEST_CASE("untangle's flips and collapses keep the topology and the boundary", "
 
 TEST_CASE("untangle with the crease guard leaves a box's edges where they are", "[untangle]") {
   // A box of 12 unit cells, its 12 edges creases (crease_lines.h). Near the middle of one edge the
-  // vertices off the edges are crumpled: moved in their face's plane by up to 1.2 (across the
-  // edge, some of them) and in or out by up to 0.4, so that faces at the crease cross each other
-  // and the faces across it. The untangling moves the crease's own vertices too (they are corners
-  // of crossing faces): without the guard it takes the box's edge out of the surface, with it
-  // every point of the 12 edges stays on the mesh.
+  // vertices off the edges are crumpled: moved in their face's plane by up to 2 (across the edge,
+  // some of them) and in or out by up to 0.8, so that faces at the crease cross each other and the
+  // faces across it. The untangling moves the crease's own vertices too (they are corners of
+  // crossing faces): without the guard it takes the box's edge out of the surface, with it the
+  // edge stays on the mesh. Seed 166 crumples a crease edge's two faces flat: the guard's test of
+  // their angle would let the edge be flipped (0.014 off; found by a review).
   const int n = 12;
   const TriMesh box = test::make_box(n);
   const ReferenceSurface surface(box);
@@ -408,11 +409,29 @@ TEST_CASE("untangle with the crease guard leaves a box's edges where they are", 
   REQUIRE_FALSE(lines.empty());
   const CreaseGuard guard(lines, 1e-9);
   const Vec3 centre(6, 0, 0);  // on the edge y = z = 0
+  // The farthest point of that edge (every 0.05) from the mesh's faces near it.
+  auto edge_off = [&](const TriMesh& mesh) {
+    double worst = 0;
+    for (int k = 0; k <= 20 * n; ++k) {
+      const Vec3 p(k / 20.0, 0, 0);
+      double best = 1e300;
+      for (auto f : mesh.faces()) {
+        Vec3 q[3];
+        int i = 0;
+        for (auto v : mesh.fv_range(f)) q[i++] = mesh.point(v);
+        if ((q[0] - p).norm() > 4) continue;  // no face of the crumpled patch reaches that far
+        best = std::min(best, (geom::closest_point_on_triangle(p, q[0], q[1], q[2]) - p).norm());
+      }
+      worst = std::max(worst, best);
+    }
+    return worst;
+  };
   int tangled = 0, cut_without = 0;
-  for (unsigned seed = 1; seed <= 16; ++seed) {
+  std::size_t crossings_before = 0, crossings_after = 0;
+  for (unsigned seed = 1; seed <= 170; ++seed) {
     INFO("seed " << seed);
     std::mt19937 rng(seed);
-    std::uniform_real_distribution<double> along(-1.2, 1.2), off(-0.4, 0.4);
+    std::uniform_real_distribution<double> along(-2, 2), off(-0.8, 0.8);
     TriMesh mesh = box;
     for (auto v : mesh.vertices()) {
       Vec3& p = mesh.point(v);
@@ -426,11 +445,15 @@ TEST_CASE("untangle with the crease guard leaves a box's edges where they are", 
     TriMesh unguarded = mesh;
     const UntangleCounts counts = untangle(mesh, surface, 0.9, 1.5, 1, &guard);
     CHECK(counts.pairs_before == before);
-    CHECK(test::box_edges_distance(mesh, n) < 1e-9);
-    CHECK(find_self_intersections(mesh, 1).size() <= before);
-    untangle(unguarded, surface, 0.9, 1.5, 1);
-    cut_without += test::box_edges_distance(unguarded, n) > 1e-3;
+    CHECK(edge_off(mesh) < 1e-9);
+    crossings_before += before;
+    crossings_after += find_self_intersections(mesh, 1).size();
+    if (tangled <= 16) {
+      untangle(unguarded, surface, 0.9, 1.5, 1);
+      cut_without += edge_off(unguarded) > 1e-3;
+    }
   }
-  CHECK(tangled >= 8);
-  CHECK(cut_without > 0);  // the guard is what keeps the edges
+  CHECK(tangled >= 80);
+  CHECK(cut_without > 0);                          // the guard is what keeps the edge
+  CHECK(4 * crossings_after < 3 * crossings_before);  // and it still untangles (about half of them)
 }
