@@ -31,6 +31,7 @@ double project_onto_reference(TriMesh& mesh, const ReferenceSurface& reference, 
 std::size_t project_vertices(TriMesh& mesh, const std::vector<OpenMesh::VertexHandle>& vertices,
                              const ReferenceSurface& reference, unsigned threads = 1,
                              const std::vector<NeighbourCache>* caches = nullptr);
+
 /// The position one vertex would take: closest_boundary_point for boundary vertices, else
 /// closest_point with `normal` as the hint (through `cache` when given).
 Vec3 project_vertex(const TriMesh& mesh, OpenMesh::VertexHandle v, const Vec3& p, const Vec3& normal,
