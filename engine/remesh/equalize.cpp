@@ -296,25 +296,6 @@ std::vector<CrossingKey> crossing_keys(const TriMesh& mesh, const std::vector<st
   return keys;
 }
 
-/// The untangling with the crease guard (keep_creases: crease vertices move along their creases,
-/// crease edges are not flipped, untangle.h), then, for the crossings that leaves, without it: a
-/// crossing is worse than a crease vertex moved. Measured (bench --spread --keep-creases, crossing
-/// face pairs summed over the five intervals; the guard ignored, as before -> the guard alone ->
-/// this): cheese simplified 65 -> 116 -> 72, cow simplified 67 -> 86 -> 67, cow refined (whose
-/// input crosses itself) 316 -> 326 -> 317; fandisk (no crossings) the same meshes throughout.
-UntangleCounts untangle_keeping(TriMesh& mesh, const ReferenceSurface& reference, const Params& params,
-                                const CreaseGuard* creases) {
-  UntangleCounts u = untangle(mesh, reference, params.e_min, params.e_max, params.threads, creases);
-  if (!creases || u.left.empty()) return u;
-  UntangleCounts rest = untangle(mesh, reference, params.e_min, params.e_max, params.threads);
-  rest.pairs_before = u.pairs_before;
-  rest.moved += u.moved;
-  rest.flipped += u.flipped;
-  rest.collapsed += u.collapsed;
-  rest.flattened += u.flattened;
-  return rest;
-}
-
 void untangle_and_mend(TriMesh& mesh, const ReferenceSurface& reference, const Params& params,
                        std::vector<NeighbourCache>& caches, const CreaseGuard* creases, IterationStats& row,
                        PhaseSeconds& phases) {
@@ -322,7 +303,8 @@ void untangle_and_mend(TriMesh& mesh, const ReferenceSurface& reference, const P
   const std::size_t outside_before = row.small + row.big;
   for (int round = 1; round <= kUntangleRounds; ++round) {
     PhaseTimer timer(phases.untangle);
-    const UntangleCounts u = untangle_keeping(mesh, reference, params, creases);
+    const UntangleCounts u =
+        untangle_creases_first(mesh, reference, params.e_min, params.e_max, params.threads, creases);
     row.cleanup_fixes += u.moved;
     // Its flips and collapses count with the row's own, as the cleanup's do (count_cleanup).
     row.flips += u.flipped;

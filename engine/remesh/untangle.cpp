@@ -756,4 +756,17 @@ UntangleCounts untangle(TriMesh& mesh, const ReferenceSurface& reference, double
   return counts;
 }
 
+UntangleCounts untangle_creases_first(TriMesh& mesh, const ReferenceSurface& reference, double e_min,
+                                      double e_max, unsigned threads, const CreaseGuard* creases) {
+  UntangleCounts first = untangle(mesh, reference, e_min, e_max, threads, creases);
+  if (!creases || first.left.empty()) return first;
+  UntangleCounts rest = untangle(mesh, reference, e_min, e_max, threads);
+  rest.pairs_before = first.pairs_before;
+  rest.moved += first.moved;
+  rest.flipped += first.flipped;
+  rest.collapsed += first.collapsed;
+  rest.flattened += first.flattened;
+  return rest;
+}
+
 }  // namespace remesh
