@@ -28,6 +28,36 @@ bool segment_crosses(const Vec3& p, const Vec3& q, const Vec3& a, const Vec3& b,
   return (u > 0 && v > 0 && w > 0) || (u < 0 && v < 0 && w < 0);
 }
 
+/// Twice the signed area of (p, q, r) in the plane of axes i and j.
+double orient2d(const Vec3& p, const Vec3& q, const Vec3& r, int i, int j) {
+  return (q[i] - p[i]) * (r[j] - p[j]) - (q[j] - p[j]) * (r[i] - p[i]);
+}
+
+/// Is p strictly inside triangle t (in the plane of axes i and j)?
+bool strictly_inside(const Vec3 t[3], const Vec3& p, int i, int j) {
+  const double u = orient2d(t[0], t[1], p, i, j), v = orient2d(t[1], t[2], p, i, j), w = orient2d(t[2], t[0], p, i, j);
+  return (u > 0 && v > 0 && w > 0) || (u < 0 && v < 0 && w < 0);
+}
+
+/// Do the insides of two triangles in one plane overlap? In the plane of the two axes the normal
+/// leans on least: an edge of one crosses an edge of the other at a point inside both, or a corner
+/// or the centroid of one lies strictly inside the other (one inside the other, edges along edges).
+bool coplanar_overlap(const Vec3 t[3], const Vec3 u[3], const Vec3& normal) {
+  const Vec3 m(std::abs(normal[0]), std::abs(normal[1]), std::abs(normal[2]));
+  const int drop = m[0] >= m[1] && m[0] >= m[2] ? 0 : (m[1] >= m[2] ? 1 : 2);
+  const int i = (drop + 1) % 3, j = (drop + 2) % 3;
+  for (int k = 0; k < 3; ++k)
+    for (int l = 0; l < 3; ++l) {
+      const Vec3 &p = t[k], &q = t[(k + 1) % 3], &r = u[l], &s = u[(l + 1) % 3];
+      const double a = orient2d(p, q, r, i, j), b = orient2d(p, q, s, i, j);
+      const double c = orient2d(r, s, p, i, j), d = orient2d(r, s, q, i, j);
+      if (((a > 0 && b < 0) || (a < 0 && b > 0)) && ((c > 0 && d < 0) || (c < 0 && d > 0))) return true;
+    }
+  for (int k = 0; k < 3; ++k)
+    if (strictly_inside(t, u[k], i, j) || strictly_inside(u, t[k], i, j)) return true;
+  return strictly_inside(t, (u[0] + u[1] + u[2]) / 3.0, i, j) || strictly_inside(u, (t[0] + t[1] + t[2]) / 3.0, i, j);
+}
+
 }  // namespace
 
 Sphere face_sphere(const TriMesh& mesh, OpenMesh::FaceHandle f) {
@@ -86,6 +116,15 @@ bool triangles_cross(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d,
     for (int j = 0; j < 3; ++j)
       if (t[i] == u[j]) shared_t = i, shared_u = j, ++shared;
   if (shared >= 2) return false;
+  // Exactly in one plane (every corner of each on the other's plane, as on a CAD model's flat face,
+  // whose points the projection puts on it exactly): the orientation tests below are all zero, and
+  // overlapping insides, a fold within the plane, would count as touching.
+  const Vec3 nt = (b - a) % (c - a), nu = (e - d) % (f - d);
+  if (nt.sqrnorm() > 0 && nu.sqrnorm() > 0 && orient(a, b, c, d) == 0 && orient(a, b, c, e) == 0 &&
+      orient(a, b, c, f) == 0 && orient(d, e, f, a) == 0 && orient(d, e, f, b) == 0 && orient(d, e, f, c) == 0) {
+    const Vec3 n(std::abs(nt[0]) + std::abs(nu[0]), std::abs(nt[1]) + std::abs(nu[1]), std::abs(nt[2]) + std::abs(nu[2]));
+    return coplanar_overlap(t, u, n);
+  }
   if (shared == 1) {
     // Both planes hold the line through the common corner s along which they meet; the part both
     // triangles hold, if any, starts at s and ends where it leaves one of them, through the edge

@@ -86,6 +86,20 @@ TEST_CASE("triangles_cross tells crossing triangles from touching and separate o
   CHECK_FALSE(triangles_cross(a, b, c, a, Vec3(-1, -1, 1), Vec3(-1, 0, -1)));
   // A common edge never counts, even folded flat onto each other.
   CHECK_FALSE(triangles_cross(a, b, c, a, b, Vec3(0.5, 0.5, 0)));
+  // In one plane (exactly: a CAD model's flat face), insides that overlap count: a corner inside
+  // the other, edges crossing, one inside the other along its edges, a common corner with the
+  // second turned into the first (a fold within the plane).
+  CHECK(triangles_cross(a, b, c, Vec3(0.5, 0.5, 0), Vec3(3, 0.5, 0), Vec3(3, 3, 0)));
+  CHECK(triangles_cross(a, b, c, Vec3(1, -1, 0), Vec3(1, 3, 0), Vec3(3, 1, 0)));
+  CHECK(triangles_cross(a, b, c, Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0)));
+  CHECK(triangles_cross(a, b, c, a, Vec3(1, 0.2, 0), Vec3(3, 3, 0)));
+  // ... and the same triangles lifted off the plane by a little do not, nor do coplanar ones that
+  // only touch: along an edge, at a corner, or a corner on an edge.
+  CHECK_FALSE(triangles_cross(a, b, c, Vec3(0.5, 0.5, 1e-9), Vec3(3, 0.5, 1e-9), Vec3(3, 3, 1e-9)));
+  CHECK_FALSE(triangles_cross(a, b, c, b, c, Vec3(2, 2, 0)));
+  CHECK_FALSE(triangles_cross(a, b, c, a, Vec3(-1, 0, 0), Vec3(0, -1, 0)));
+  CHECK_FALSE(triangles_cross(a, b, c, Vec3(1, 1, 0), Vec3(2, 2, 0), Vec3(3, 1, 0)));
+  CHECK_FALSE(triangles_cross(a, b, c, Vec3(3, 0, 0), Vec3(4, 0, 0), Vec3(3, 1, 0)));
   // The answer does not depend on the order of the triangles or of their corners.
   std::mt19937 rng(7);
   std::uniform_real_distribution<double> d(-1, 1);
@@ -100,6 +114,18 @@ TEST_CASE("triangles_cross tells crossing triangles from touching and separate o
     crossing += x;
   }
   CHECK(crossing > 100);  // the random triangles do cross often
+  // The same in one plane (z = 0), where the orientation tests are exactly zero.
+  int overlapping = 0;
+  for (int k = 0; k < 2000; ++k) {
+    Vec3 p[6];
+    for (auto& q : p) q = Vec3(d(rng), d(rng), 0);
+    const bool x = triangles_cross(p[0], p[1], p[2], p[3], p[4], p[5]);
+    CHECK(x == triangles_cross(p[3], p[4], p[5], p[0], p[1], p[2]));
+    CHECK(x == triangles_cross(p[1], p[2], p[0], p[5], p[3], p[4]));
+    CHECK(x == triangles_cross(p[0], p[2], p[1], p[3], p[5], p[4]));
+    overlapping += x;
+  }
+  CHECK(overlapping > 100);
 }
 
 TEST_CASE("find_self_intersections finds the pairs a brute-force test finds", "[untangle]") {
