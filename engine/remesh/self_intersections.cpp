@@ -33,29 +33,31 @@ double orient2d(const Vec3& p, const Vec3& q, const Vec3& r, int i, int j) {
   return (q[i] - p[i]) * (r[j] - p[j]) - (q[j] - p[j]) * (r[i] - p[i]);
 }
 
-/// Is p strictly inside triangle t (in the plane of axes i and j)?
-bool strictly_inside(const Vec3 t[3], const Vec3& p, int i, int j) {
-  const double u = orient2d(t[0], t[1], p, i, j), v = orient2d(t[1], t[2], p, i, j), w = orient2d(t[2], t[0], p, i, j);
-  return (u > 0 && v > 0 && w > 0) || (u < 0 && v < 0 && w < 0);
+/// Is a line through an edge of t one that the whole of u lies on or beyond, on the side away
+/// from t (in the plane of axes i and j)?
+bool separates(const Vec3 t[3], const Vec3 u[3], int i, int j) {
+  const double own = orient2d(t[0], t[1], t[2], i, j);
+  for (int k = 0; k < 3; ++k) {
+    const Vec3 &p = t[k], &q = t[(k + 1) % 3];
+    bool all_beyond = true;
+    for (int l = 0; l < 3 && all_beyond; ++l) {
+      const double side = orient2d(p, q, u[l], i, j);
+      all_beyond = own > 0 ? side <= 0 : side >= 0;
+    }
+    if (all_beyond) return true;
+  }
+  return false;
 }
 
 /// Do the insides of two triangles in one plane overlap? In the plane of the two axes the normal
-/// leans on least: an edge of one crosses an edge of the other at a point inside both, or a corner
-/// or the centroid of one lies strictly inside the other (one inside the other, edges along edges).
+/// leans on least, they do unless a line through an edge of one has the other wholly on or beyond
+/// it (two convex polygons whose insides are apart are parted by such a line); touching along an
+/// edge or at a corner leaves them apart.
 bool coplanar_overlap(const Vec3 t[3], const Vec3 u[3], const Vec3& normal) {
   const Vec3 m(std::abs(normal[0]), std::abs(normal[1]), std::abs(normal[2]));
   const int drop = m[0] >= m[1] && m[0] >= m[2] ? 0 : (m[1] >= m[2] ? 1 : 2);
   const int i = (drop + 1) % 3, j = (drop + 2) % 3;
-  for (int k = 0; k < 3; ++k)
-    for (int l = 0; l < 3; ++l) {
-      const Vec3 &p = t[k], &q = t[(k + 1) % 3], &r = u[l], &s = u[(l + 1) % 3];
-      const double a = orient2d(p, q, r, i, j), b = orient2d(p, q, s, i, j);
-      const double c = orient2d(r, s, p, i, j), d = orient2d(r, s, q, i, j);
-      if (((a > 0 && b < 0) || (a < 0 && b > 0)) && ((c > 0 && d < 0) || (c < 0 && d > 0))) return true;
-    }
-  for (int k = 0; k < 3; ++k)
-    if (strictly_inside(t, u[k], i, j) || strictly_inside(u, t[k], i, j)) return true;
-  return strictly_inside(t, (u[0] + u[1] + u[2]) / 3.0, i, j) || strictly_inside(u, (t[0] + t[1] + t[2]) / 3.0, i, j);
+  return !separates(t, u, i, j) && !separates(u, t, i, j);
 }
 
 }  // namespace

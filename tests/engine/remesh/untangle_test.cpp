@@ -93,6 +93,10 @@ TEST_CASE("triangles_cross tells crossing triangles from touching and separate o
   CHECK(triangles_cross(a, b, c, Vec3(1, -1, 0), Vec3(1, 3, 0), Vec3(3, 1, 0)));
   CHECK(triangles_cross(a, b, c, Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0)));
   CHECK(triangles_cross(a, b, c, a, Vec3(1, 0.2, 0), Vec3(3, 3, 0)));
+  // ... also where only touching contacts bound the overlap and neither centroid is inside the
+  // other (found in review): edges along edges, and a common corner.
+  CHECK(triangles_cross(a, b, c, Vec3(1, 0, 0), Vec3(4, 0, 0), Vec3(1, 1, 0)));
+  CHECK(triangles_cross(a, b, c, a, Vec3(1.5, 0.5, 0), Vec3(3, -1, 0)));
   // ... and the same triangles lifted off the plane by a little do not, nor do coplanar ones that
   // only touch: along an edge, at a corner, or a corner on an edge.
   CHECK_FALSE(triangles_cross(a, b, c, Vec3(0.5, 0.5, 1e-9), Vec3(3, 0.5, 1e-9), Vec3(3, 3, 1e-9)));
