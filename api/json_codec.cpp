@@ -56,7 +56,8 @@ const std::vector<ParamSpec>& param_specs() {
       {"iterations", Kind::Integer, false}, {"rings", Kind::Integer, false},
       {"relax_every", Kind::Integer, false}, {"flip_factor", Kind::Real, false},
       {"run_all_iterations", Kind::Boolean, false}, {"protect_tips", Kind::Boolean, false},
-      {"keep_creases", Kind::Boolean, false},       {"weld", Kind::Boolean, false},
+      {"keep_creases", Kind::Boolean, false},       {"relax_dual", Kind::Boolean, false},
+      {"weld", Kind::Boolean, false},
   };
   return specs;
 }
@@ -79,6 +80,7 @@ void store(ParsedParams& out, std::string_view name, const Value& v) {
   else if (name == "run_all_iterations") p.run_all_iterations = v.boolean;
   else if (name == "protect_tips") p.protect_tips = v.boolean;
   else if (name == "keep_creases") p.keep_creases = v.boolean;
+  else if (name == "relax_dual") p.relax_dual = v.boolean;
   else if (name == "weld") out.weld = v.boolean;
 }
 
@@ -232,7 +234,8 @@ void to_json(json& j, const Params& p) {
            {"flip_factor", p.flip_factor},
            {"run_all_iterations", p.run_all_iterations},
            {"protect_tips", p.protect_tips},
-           {"keep_creases", p.keep_creases}};
+           {"keep_creases", p.keep_creases},
+           {"relax_dual", p.relax_dual}};
 }
 
 void to_json(json& j, const FieldError& e) { j = json{{"field", e.field}, {"message", e.message}}; }

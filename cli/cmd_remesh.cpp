@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <climits>
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <iostream>
@@ -11,6 +12,7 @@
 
 #include "args.h"
 #include "commands.h"
+#include "dual/relax_bonds.h"
 #include "dual/trivalent_dual.h"
 #include "interrupt.h"
 #include "io/summary.h"
@@ -33,6 +35,7 @@ const std::vector<OptionSpec> kSpec = {
     {"protect-tips", "", "never move tips (ears, horns, spikes) to mend edges: closer to the input there, more edges outside"},
     {"keep-creases", "", "keep the input's sharp edges (over 75 degrees) exactly, as CAD models need; more edges may stay outside"},
     {"dual", "DUAL_OUT", "also write the trivalent dual of the result, projected onto IN"},
+    {"relax-dual", "", "relax the dual's bonds toward the middle of [A, B] / sqrt(3) (atom lattices); needs --dual"},
     {"stats", "FILE", "write the per-iteration statistics to FILE.csv or FILE.json"},
     {"threads", "T", "worker threads; 0 = all cores (default 0; results do not depend on it)"},
     {"max-faces", "N", "refuse inputs and estimated outputs over N faces; 0 = no limit (default 20000000)"},
@@ -77,6 +80,7 @@ Job parse_job(const std::vector<std::string>& args) {
   p.run_all_iterations = a.has("all-iterations");
   p.protect_tips = a.has("protect-tips");
   p.keep_creases = a.has("keep-creases");
+  p.relax_dual = a.has("relax-dual");
   job.read.weld = a.has("weld");
   job.quiet = a.has("quiet");
   job.dual_out = a.get("dual");
@@ -90,6 +94,7 @@ Job parse_job(const std::vector<std::string>& args) {
   require_input_file(job.in);
   require_output_format(job.out);
   if (job.dual_out) require_output_format(*job.dual_out);
+  if (p.relax_dual && !job.dual_out) throw UsageError("--relax-dual: relaxes the dual's bonds, so it needs --dual DUAL_OUT");
   if (job.stats_out) {
     const auto& s = *job.stats_out;
     auto ends = [&](const char* ext) { return s.size() > 4 && s.compare(s.size() - 4, 4, ext) == 0; };
@@ -173,7 +178,10 @@ int run_remesh(const std::vector<std::string>& args) {
   write_mesh_file(to_soup(mesh), job.out);
   std::optional<DualStats> dual_summary;
   if (job.dual_out) {
-    const PolyMesh dual = trivalent_dual(mesh, &*reference);
+    PolyMesh dual = trivalent_dual(mesh, &*reference);
+    if (job.params.relax_dual)
+      relax_bonds(dual, job.params.e_min / std::sqrt(3.0), job.params.e_max / std::sqrt(3.0), *reference,
+                  job.params.threads);
     write_mesh_file(to_soup(dual), *job.dual_out);
     if (!job.quiet) dual_summary = dual_stats(dual, job.params.e_min, job.params.e_max);  // for the summary only
   }

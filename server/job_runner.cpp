@@ -1,7 +1,9 @@
 #include "job_runner.h"
 
+#include <cmath>
 #include <stdexcept>
 
+#include "dual/relax_bonds.h"
 #include "dual/trivalent_dual.h"
 #include "io/mesh_io.h"
 #include "remesh/mesh_snapshot.h"
@@ -56,6 +58,8 @@ RunOutput run_job(const remesh::api::JobRecord& job, std::string upload, unsigne
     return remesh::ReferenceSurface(input_mesh);
   }();
   remesh::PolyMesh dual = remesh::trivalent_dual(mesh, &reference);
+  if (params.relax_dual)
+    remesh::relax_bonds(dual, params.e_min / std::sqrt(3.0), params.e_max / std::sqrt(3.0), reference, params.threads);
   out.dual = remesh::dual_stats(dual, params.e_min, params.e_max);
   for (const std::string& f : remesh::api::dual_formats())
     write("dual." + f, remesh::write_mesh(dual, format_of(f)));

@@ -47,6 +47,10 @@ struct Params {
   /// e_min between two creases: a third of the edges left outside are short edges between crease
   /// points, which no collapse may merge), cow refined 99.91 / 1.19 -> 99.79 / 1.27.
   bool keep_creases = false;
+  /// Not in the thesis, and not used by equalize(): whoever builds the result's trivalent dual
+  /// (the CLI's --dual, the service) relaxes its bonds toward the middle of [e_min, e_max] / sqrt(3)
+  /// (dual/relax_bonds.h), instead of leaving each dual vertex at its triangle's centroid.
+  bool relax_dual = false;
 };
 
 /// Every invalid field, named as the API names it: "emin", "emax", "rings", "iterations",

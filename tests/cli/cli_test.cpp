@@ -305,6 +305,37 @@ TEST_CASE("a short remesh run writes the mesh, the dual and one stats row per it
   CHECK(stats.back().contains("max_projection_distance"));
 }
 
+TEST_CASE("remesh --relax-dual puts more of the dual's bonds inside the bond interval, and needs --dual", "[cli]") {
+  TempDir dir;
+  write_obj(remesh::test::make_icosphere(3), dir.file("sphere.obj"));
+  // The share of bonds inside, from the summary line "bonds inside [..] = [e_min, e_max] / sqrt(3): X %".
+  auto bonds_inside = [](const std::string& out) {
+    const std::string key = "= [e_min, e_max] / sqrt(3): ";
+    const std::size_t at = out.find(key);
+    REQUIRE(at != std::string::npos);
+    return std::stod(out.substr(at + key.size()));
+  };
+  // A tight interval (+- 10 %) around the sphere's mean edge.
+  std::vector<std::string> args = {dir.file("sphere.obj"), dir.file("out.obj"), "--emin", "0.14", "--emax", "0.17",
+                                   "--dual", dir.file("dual.obj")};
+  const ProcessResult plain = remesh_cli(args);
+  INFO(plain.err);
+  REQUIRE(plain.exit_code == 0);
+  args.push_back("--relax-dual");
+  const ProcessResult relaxed = remesh_cli(args);
+  INFO(relaxed.err);
+  REQUIRE(relaxed.exit_code == 0);
+  INFO("bonds inside: " << bonds_inside(plain.out) << " % -> " << bonds_inside(relaxed.out) << " %");
+  CHECK(bonds_inside(relaxed.out) > bonds_inside(plain.out) + 5);
+  CHECK(bonds_inside(relaxed.out) > 97);
+
+  const ProcessResult alone = remesh_cli({dir.file("sphere.obj"), dir.file("out.obj"), "--emin", "0.14", "--emax",
+                                          "0.17", "--relax-dual"});
+  CHECK(alone.exit_code == 2);
+  CHECK(alone.err.find("--relax-dual") != std::string::npos);
+  CHECK(std::count(alone.err.begin(), alone.err.end(), '\n') == 1);
+}
+
 TEST_CASE("the summary says how many edges outside lie in parts too thin for the interval", "[cli]") {
   TempDir dir;
   // A torus whose tube is 0.5 across: no ring of edges of at least 1.2 follows it.

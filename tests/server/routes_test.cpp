@@ -1,6 +1,7 @@
 // Every route and every error status of the public API, against the real daemon.
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <iterator>
@@ -191,6 +192,44 @@ TEST_CASE("remeshd: submit raw and multipart, follow, download, list, delete", "
         std::string::npos);
   CHECK(metrics->body.find("remeshd_http_request_duration_seconds_bucket{route=\"/api/v1/jobs/{id}/result\"") !=
         std::string::npos);
+}
+
+TEST_CASE("remeshd: relax_dual relaxes the dual's bonds, and its downloads are that dual", "[server]") {
+  TempDir tmp;
+  Daemon d(tmp.path / "data", {"--workers", "2"});
+  auto c = d.client();
+  const std::string mesh = sphere_obj(3);
+  // A tight interval (+- 10 %): the centroids' bonds spread more than the edges.
+  auto plain = submit_raw(c, mesh, "emin=0.14&emax=0.17&filename=ball.obj");
+  auto relaxed = submit_raw(c, mesh, "emin=0.14&emax=0.17&relax_dual=true&filename=ball.obj");
+  REQUIRE(plain);
+  REQUIRE(relaxed);
+  REQUIRE(plain->status == 202);
+  REQUIRE(relaxed->status == 202);
+  CHECK(body_of(relaxed)["params"]["relax_dual"] == true);
+  CHECK(body_of(plain)["params"]["relax_dual"] == false);
+  const json a = wait_final(c, body_of(plain)["id"]), b = wait_final(c, body_of(relaxed)["id"]);
+  REQUIRE(a["state"] == "succeeded");
+  REQUIRE(b["state"] == "succeeded");
+  const double before = a["dual"]["bonds_inside_fraction"], after = b["dual"]["bonds_inside_fraction"];
+  INFO("bonds inside " << before << " -> " << after);
+  CHECK(after > before + 0.05);
+  CHECK(after > 0.97);
+  // The downloaded dual is the relaxed one: same atoms, moved.
+  auto plain_xyz = c.Get(a["links"]["results"]["dual"]["xyz"].get<std::string>().c_str());
+  auto relaxed_xyz = c.Get(b["links"]["results"]["dual"]["xyz"].get<std::string>().c_str());
+  REQUIRE(plain_xyz);
+  REQUIRE(relaxed_xyz);
+  CHECK(plain_xyz->status == 200);
+  CHECK(relaxed_xyz->status == 200);
+  CHECK(std::count(plain_xyz->body.begin(), plain_xyz->body.end(), '\n') ==
+        std::count(relaxed_xyz->body.begin(), relaxed_xyz->body.end(), '\n'));
+  CHECK(plain_xyz->body != relaxed_xyz->body);
+  // Not a boolean: a 422 that names it.
+  auto bad = submit_raw(c, mesh, "emin=0.14&emax=0.17&relax_dual=maybe");
+  REQUIRE(bad);
+  CHECK(bad->status == 422);
+  CHECK(error_fields(bad) == std::set<std::string>{"relax_dual"});
 }
 
 TEST_CASE("remeshd: the errors each route must give", "[server]") {

@@ -1,0 +1,113 @@
+#include "dual/relax_bonds.h"
+
+#include <vector>
+
+#include "core/parallel.h"
+#include "remesh/reference_surface.h"
+
+namespace remesh {
+
+namespace {
+
+/// Iterations without a new high of bonds inside before the relaxation stops.
+constexpr int kPatience = 8;
+/// Share of the way to the spring target a vertex moves per iteration (Jacobi: all at once).
+constexpr double kStep = 0.5;
+
+std::size_t count_inside(const PolyMesh& dual, double lo, double hi) {
+  std::size_t n = 0;
+  for (auto e : dual.edges()) {
+    const double l = dual.calc_edge_length(e);
+    n += l >= lo && l <= hi;
+  }
+  return n;
+}
+
+/// Newell's normal of a face (not normalised): robust for the dual's non-planar polygons.
+Vec3 newell_normal(const PolyMesh& dual, PolyMesh::FaceHandle f) {
+  Vec3 n(0, 0, 0);
+  for (auto h : dual.fh_range(f)) {
+    const Vec3& a = dual.point(dual.from_vertex_handle(h));
+    const Vec3& b = dual.point(dual.to_vertex_handle(h));
+    n += Vec3((a[1] - b[1]) * (a[2] + b[2]), (a[2] - b[2]) * (a[0] + b[0]), (a[0] - b[0]) * (a[1] + b[1]));
+  }
+  return n;
+}
+
+}  // namespace
+
+BondRelaxation relax_bonds(PolyMesh& dual, double bond_min, double bond_max, const ReferenceSurface& reference,
+                           unsigned threads, int max_iterations) {
+  BondRelaxation r;
+  r.bonds = dual.n_edges();
+  r.inside_before = r.inside_after = count_inside(dual, bond_min, bond_max);
+  const double rest = 0.5 * (bond_min + bond_max);
+  const std::size_t nv = dual.n_vertices(), nf = dual.n_faces();
+  std::vector<char> movable(nv, 0);
+  for (auto v : dual.vertices()) movable[v.idx()] = !dual.is_boundary(v) && dual.valence(v) == 3;
+  std::vector<Vec3> best(nv), target(nv), normal(nv), face_normal(nf);
+  std::vector<NeighbourCache> caches(nv);  // each vertex's last kd-tree answer (reference_surface.h)
+  for (auto v : dual.vertices()) best[v.idx()] = dual.point(v);
+  int since_best = 0;
+  while (r.inside_after < r.bonds && r.iterations < max_iterations && since_best < kPatience) {
+    ++r.iterations;
+    parallel_for(nf, threads, [&](std::size_t f) { face_normal[f] = newell_normal(dual, dual.face_handle(f)); });
+    // A vertex's normal: the sum of its faces' (unit) normals.
+    parallel_for(nv, threads, [&](std::size_t i) {
+      Vec3 n(0, 0, 0);
+      for (auto f : dual.vf_range(dual.vertex_handle(static_cast<unsigned>(i)))) {
+        const double len = face_normal[f.idx()].norm();
+        if (len > 0) n += face_normal[f.idx()] / len;
+      }
+      const double len = n.norm();
+      normal[i] = len > 0 ? n / len : n;
+    });
+    parallel_for(nv, threads, [&](std::size_t i) {
+      const auto v = dual.vertex_handle(static_cast<unsigned>(i));
+      const Vec3 x = dual.point(v);
+      target[i] = x;
+      if (!movable[i]) return;
+      Vec3 move(0, 0, 0);
+      int n = 0;
+      for (auto w : dual.vv_range(v)) {
+        const Vec3 d = x - dual.point(w);
+        const double l = d.norm();
+        if (!(l > 0)) continue;
+        move += dual.point(w) + d * (rest / l) - x;
+        ++n;
+      }
+      if (n == 0) return;
+      move /= n;
+      move -= (move | normal[i]) * normal[i];
+      target[i] = reference.closest_point(x + kStep * move, normal[i], caches[i]);
+    });
+    std::vector<Vec3> before(nv);
+    for (std::size_t i = 0; i < nv; ++i) {
+      const auto v = dual.vertex_handle(static_cast<unsigned>(i));
+      before[i] = dual.point(v);
+      dual.point(v) = target[i];
+    }
+    // Undo the moves around a face turned over, until none is (each round undoes at least one).
+    for (bool undone = true; undone;) {
+      undone = false;
+      for (auto f : dual.faces()) {
+        if ((newell_normal(dual, f) | face_normal[f.idx()]) > 0) continue;
+        for (auto v : dual.fv_range(f))
+          if (dual.point(v) != before[v.idx()]) dual.point(v) = before[v.idx()], undone = true;
+      }
+    }
+    const std::size_t inside = count_inside(dual, bond_min, bond_max);
+    if (inside > r.inside_after) {
+      r.inside_after = inside;
+      since_best = 0;
+      for (auto v : dual.vertices()) best[v.idx()] = dual.point(v);
+    } else {
+      ++since_best;
+    }
+  }
+  for (auto v : dual.vertices()) dual.point(v) = best[v.idx()];
+  dual.update_normals();
+  return r;
+}
+
+}  // namespace remesh
