@@ -13,6 +13,8 @@ namespace {
 constexpr int kPatience = 8;
 /// Share of the way to the spring target a vertex moves per iteration (Jacobi: all at once).
 constexpr double kStep = 0.5;
+/// Bonds shorter than this share of the rest length count as two atoms in one place.
+constexpr double kCoincident = 1e-9;
 
 std::size_t count_inside(const PolyMesh& dual, double lo, double hi) {
   std::size_t n = 0;
@@ -45,7 +47,7 @@ BondRelaxation relax_bonds(PolyMesh& dual, double bond_min, double bond_max, con
   const std::size_t nv = dual.n_vertices(), nf = dual.n_faces();
   std::vector<char> movable(nv, 0);
   for (auto v : dual.vertices()) movable[v.idx()] = !dual.is_boundary(v) && dual.valence(v) == 3;
-  std::vector<Vec3> best(nv), target(nv), normal(nv), face_normal(nf);
+  std::vector<Vec3> best(nv), target(nv), free(nv), settled(nv), normal(nv), face_normal(nf);
   std::vector<NeighbourCache> caches(nv);  // each vertex's last kd-tree answer (reference_surface.h)
   for (auto v : dual.vertices()) best[v.idx()] = dual.point(v);
   int since_best = 0;
@@ -67,20 +69,44 @@ BondRelaxation relax_bonds(PolyMesh& dual, double bond_min, double bond_max, con
       const Vec3 x = dual.point(v);
       target[i] = x;
       if (!movable[i]) return;
-      Vec3 move(0, 0, 0);
+      Vec3 move(0, 0, 0), around(0, 0, 0);
       int n = 0;
+      for (auto w : dual.vv_range(v)) around += dual.point(w) / 3.0;
       for (auto w : dual.vv_range(v)) {
-        const Vec3 d = x - dual.point(w);
-        const double l = d.norm();
-        if (!(l > 0)) continue;
+        Vec3 d = x - dual.point(w);
+        double l = d.norm();
+        // Two atoms in one place (the projection can put two centroids on one point of a thin
+        // part): apart along the direction from the other to this one's other neighbours.
+        if (!(l > kCoincident * rest)) {
+          d = (around * 3.0 - dual.point(w)) / 2.0 - dual.point(w);
+          l = d.norm();
+          if (!(l > 0)) continue;
+          d *= kCoincident * rest / l;
+          l = kCoincident * rest;
+        }
         move += dual.point(w) + d * (rest / l) - x;
         ++n;
       }
       if (n == 0) return;
       move /= n;
       move -= (move | normal[i]) * normal[i];
-      target[i] = reference.closest_point(x + kStep * move, normal[i], caches[i]);
+      free[i] = x + kStep * move;
+      target[i] = reference.closest_point(free[i], normal[i], caches[i]);
     });
+    // Where the projection would put two bonded atoms in one place (a reference corner that every
+    // point nearby projects to: the three centroids around a valence-3 vertex at cheese's sharp
+    // corners), the atom stays off the surface by its short move instead.
+    parallel_for(nv, threads, [&](std::size_t i) {
+      if (!movable[i]) return;
+      for (auto w : dual.vv_range(dual.vertex_handle(static_cast<unsigned>(i))))
+        if ((target[w.idx()] - target[i]).norm() <= kCoincident * rest) {
+          settled[i] = free[i];
+          return;
+        }
+      settled[i] = target[i];
+    });
+    for (std::size_t i = 0; i < nv; ++i)
+      if (movable[i]) target[i] = settled[i];
     std::vector<Vec3> before(nv);
     for (std::size_t i = 0; i < nv; ++i) {
       const auto v = dual.vertex_handle(static_cast<unsigned>(i));
@@ -91,7 +117,8 @@ BondRelaxation relax_bonds(PolyMesh& dual, double bond_min, double bond_max, con
     for (bool undone = true; undone;) {
       undone = false;
       for (auto f : dual.faces()) {
-        if ((newell_normal(dual, f) | face_normal[f.idx()]) > 0) continue;
+        // A ring with no area (its atoms in one place) has no side to turn over to.
+        if (face_normal[f.idx()].sqrnorm() == 0 || (newell_normal(dual, f) | face_normal[f.idx()]) > 0) continue;
         for (auto v : dual.fv_range(f))
           if (dual.point(v) != before[v.idx()]) dual.point(v) = before[v.idx()], undone = true;
       }

@@ -120,3 +120,20 @@ TEST_CASE("relaxing bonds already inside the interval changes nothing", "[dual]"
   CHECK(r.inside_after == r.bonds);
   for (auto v : dual.vertices()) CHECK(dual.point(v) == before.point(v));
 }
+
+TEST_CASE("atoms in one place are pushed apart", "[dual]") {
+  // A whole ring in one point (the projection can put the three centroids around a valence-3
+  // vertex on one corner of a thin part): a ring with no area, and bonds with no direction.
+  const TriMesh mesh = test::make_icosphere(3, kRadius);
+  const ReferenceSurface reference(mesh);
+  PolyMesh dual = trivalent_dual(mesh, &reference);
+  double rest = 0;
+  for (auto e : dual.edges()) rest += dual.calc_edge_length(e) / static_cast<double>(dual.n_edges());
+  const auto ring = dual.face_handle(0);
+  std::vector<PolyMesh::VertexHandle> atoms(dual.fv_range(ring).begin(), dual.fv_range(ring).end());
+  for (auto v : atoms) dual.point(v) = dual.point(atoms[0]);
+  const BondRelaxation r = relax_bonds(dual, 0.9 * rest, 1.1 * rest, reference);
+  CHECK(r.iterations > 0);
+  for (auto e : dual.edges()) CHECK(dual.calc_edge_length(e) > 0.5 * rest);
+  CHECK(r.inside_after == r.bonds);
+}
