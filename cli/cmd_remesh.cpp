@@ -111,7 +111,8 @@ void write_text_file(const std::string& path, const std::string& text) {
   if (!f.flush()) throw std::runtime_error("write failed: " + path);
 }
 
-void print_final(const TriMesh& mesh, const Job& job, const Result& result, const std::optional<DualStats>& dual) {
+void print_final(const TriMesh& mesh, const Job& job, const Result& result, const std::optional<DualStats>& dual,
+                 const std::optional<BondRelaxation>& relaxed) {
   const IterationStats q = measure(mesh, job.params.e_min, job.params.e_max, job.params.threads);
   const MeshSummary s = summarize(mesh);
   std::printf("result: %zu vertices, %zu edges, %zu faces\n", s.vertices, s.edges, s.faces);
@@ -132,6 +133,12 @@ void print_final(const TriMesh& mesh, const Job& job, const Result& result, cons
     std::fflush(stdout);
     print_dual_stats(std::cout, *dual);
     std::cout.flush();
+  }
+  if (relaxed && relaxed->bonds > 0) {
+    const double n = static_cast<double>(relaxed->bonds);
+    std::printf("  bonds relaxed:        %d iteration%s, inside %.3f %% -> %.3f %%, %.2f s\n", relaxed->iterations,
+                relaxed->iterations == 1 ? "" : "s", 100.0 * static_cast<double>(relaxed->inside_before) / n,
+                100.0 * static_cast<double>(relaxed->inside_after) / n, relaxed->seconds);
   }
   std::printf("  outcome:              %s after %d iteration%s, %.2f s\n", outcome_name(result.outcome),
               result.iterations_done, result.iterations_done == 1 ? "" : "s", result.seconds);
@@ -177,11 +184,12 @@ int run_remesh(const std::vector<std::string>& args) {
 
   write_mesh_file(to_soup(mesh), job.out);
   std::optional<DualStats> dual_summary;
+  std::optional<BondRelaxation> relaxed;
   if (job.dual_out) {
     PolyMesh dual = trivalent_dual(mesh, &*reference);
     if (job.params.relax_dual)
-      relax_bonds(dual, job.params.e_min / std::sqrt(3.0), job.params.e_max / std::sqrt(3.0), *reference,
-                  job.params.threads);
+      relaxed = relax_bonds(dual, job.params.e_min / std::sqrt(3.0), job.params.e_max / std::sqrt(3.0), *reference,
+                            job.params.threads);
     write_mesh_file(to_soup(dual), *job.dual_out);
     if (!job.quiet) dual_summary = dual_stats(dual, job.params.e_min, job.params.e_max);  // for the summary only
   }
@@ -189,7 +197,7 @@ int run_remesh(const std::vector<std::string>& args) {
     const bool json = job.stats_out->size() > 5 && job.stats_out->ends_with(".json");
     write_text_file(*job.stats_out, json ? nlohmann::json(rows).dump(2) + "\n" : stats_to_csv(rows));
   }
-  if (!job.quiet) print_final(mesh, job, result, dual_summary);
+  if (!job.quiet) print_final(mesh, job, result, dual_summary, relaxed);
   if (result.outcome == Outcome::Cancelled) {
     std::cerr << "remesh: cancelled after " << result.iterations_done << " iterations; wrote the partial mesh to "
               << job.out << "\n";

@@ -1,5 +1,6 @@
 #include "dual/relax_bonds.h"
 
+#include <chrono>
 #include <vector>
 
 #include "core/parallel.h"
@@ -40,6 +41,7 @@ Vec3 newell_normal(const PolyMesh& dual, PolyMesh::FaceHandle f) {
 
 BondRelaxation relax_bonds(PolyMesh& dual, double bond_min, double bond_max, const ReferenceSurface& reference,
                            unsigned threads, int max_iterations) {
+  const auto start = std::chrono::steady_clock::now();
   BondRelaxation r;
   r.bonds = dual.n_edges();
   r.inside_before = r.inside_after = count_inside(dual, bond_min, bond_max);
@@ -134,6 +136,7 @@ BondRelaxation relax_bonds(PolyMesh& dual, double bond_min, double bond_max, con
   }
   for (auto v : dual.vertices()) dual.point(v) = best[v.idx()];
   dual.update_normals();
+  r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return r;
 }
 

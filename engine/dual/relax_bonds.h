@@ -31,6 +31,7 @@ struct BondRelaxation {
   std::size_t inside_before = 0;    ///< bonds inside [bond_min, bond_max] before
   std::size_t inside_after = 0;     ///< and after (never fewer)
   std::size_t bonds = 0;
+  double seconds = 0;               ///< time spent
 };
 
 /// Relaxes the bonds of `dual` (a trivalent_dual() result) toward (bond_min + bond_max) / 2, its

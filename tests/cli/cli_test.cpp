@@ -328,6 +328,8 @@ TEST_CASE("remesh --relax-dual puts more of the dual's bonds inside the bond int
   INFO("bonds inside: " << bonds_inside(plain.out) << " % -> " << bonds_inside(relaxed.out) << " %");
   CHECK(bonds_inside(relaxed.out) > bonds_inside(plain.out) + 5);
   CHECK(bonds_inside(relaxed.out) > 97);
+  CHECK(relaxed.out.find("  bonds relaxed:        ") != std::string::npos);
+  CHECK(plain.out.find("bonds relaxed") == std::string::npos);
 
   const ProcessResult alone = remesh_cli({dir.file("sphere.obj"), dir.file("out.obj"), "--emin", "0.14", "--emax",
                                           "0.17", "--relax-dual"});
