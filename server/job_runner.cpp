@@ -58,8 +58,15 @@ RunOutput run_job(const remesh::api::JobRecord& job, std::string upload, unsigne
     return remesh::ReferenceSurface(input_mesh);
   }();
   remesh::PolyMesh dual = remesh::trivalent_dual(mesh, &reference);
-  if (params.relax_dual)
-    remesh::relax_bonds(dual, params.e_min / std::sqrt(3.0), params.e_max / std::sqrt(3.0), reference, params.threads);
+  if (params.relax_dual) {
+    remesh::relax_bonds(dual, params.e_min / std::sqrt(3.0), params.e_max / std::sqrt(3.0), reference, params.threads,
+                        60, stop);
+    // A stop asked for meanwhile (DELETE, shutdown) cancels the job, as during the run.
+    if (stop.stop_requested()) {
+      out.outcome = remesh::Outcome::Cancelled;
+      return out;
+    }
+  }
   out.dual = remesh::dual_stats(dual, params.e_min, params.e_max);
   for (const std::string& f : remesh::api::dual_formats())
     write("dual." + f, remesh::write_mesh(dual, format_of(f)));

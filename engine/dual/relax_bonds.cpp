@@ -1,6 +1,8 @@
 #include "dual/relax_bonds.h"
 
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <vector>
 
 #include "core/parallel.h"
@@ -16,6 +18,8 @@ constexpr int kPatience = 8;
 constexpr double kStep = 0.5;
 /// Bonds shorter than this share of the rest length count as two atoms in one place.
 constexpr double kCoincident = 1e-9;
+/// The longest move per iteration, as a share of the rest length.
+constexpr double kMaxStep = 0.5;
 
 std::size_t count_inside(const PolyMesh& dual, double lo, double hi) {
   std::size_t n = 0;
@@ -40,12 +44,18 @@ Vec3 newell_normal(const PolyMesh& dual, PolyMesh::FaceHandle f) {
 }  // namespace
 
 BondRelaxation relax_bonds(PolyMesh& dual, double bond_min, double bond_max, const ReferenceSurface& reference,
-                           unsigned threads, int max_iterations) {
+                           unsigned threads, int max_iterations, std::stop_token stop) {
   const auto start = std::chrono::steady_clock::now();
   BondRelaxation r;
   r.bonds = dual.n_edges();
   r.inside_before = r.inside_after = count_inside(dual, bond_min, bond_max);
-  const double rest = 0.5 * (bond_min + bond_max);
+  // The rest length: the middle of the interval, but within the bonds' own range (an interval
+  // open upward, e_max up to the bounding box's diagonal, would fling the atoms across the model).
+  double sum = 0;
+  for (auto e : dual.edges()) sum += dual.calc_edge_length(e);
+  const double mean = r.bonds > 0 ? sum / static_cast<double>(r.bonds) : 0;
+  const double rest = std::clamp(0.5 * (bond_min + bond_max), std::max(bond_min, 0.8 * mean),
+                                 std::max(bond_min, std::min(bond_max, 1.25 * mean)));
   const std::size_t nv = dual.n_vertices(), nf = dual.n_faces();
   std::vector<char> movable(nv, 0);
   for (auto v : dual.vertices()) movable[v.idx()] = !dual.is_boundary(v) && dual.valence(v) == 3;
@@ -53,7 +63,8 @@ BondRelaxation relax_bonds(PolyMesh& dual, double bond_min, double bond_max, con
   std::vector<NeighbourCache> caches(nv);  // each vertex's last kd-tree answer (reference_surface.h)
   for (auto v : dual.vertices()) best[v.idx()] = dual.point(v);
   int since_best = 0;
-  while (r.inside_after < r.bonds && r.iterations < max_iterations && since_best < kPatience) {
+  while (r.inside_after < r.bonds && r.iterations < max_iterations && since_best < kPatience &&
+         !stop.stop_requested()) {
     ++r.iterations;
     parallel_for(nf, threads, [&](std::size_t f) { face_normal[f] = newell_normal(dual, dual.face_handle(f)); });
     // A vertex's normal: the sum of its faces' (unit) normals.
@@ -69,7 +80,7 @@ BondRelaxation relax_bonds(PolyMesh& dual, double bond_min, double bond_max, con
     parallel_for(nv, threads, [&](std::size_t i) {
       const auto v = dual.vertex_handle(static_cast<unsigned>(i));
       const Vec3 x = dual.point(v);
-      target[i] = x;
+      target[i] = free[i] = x;
       if (!movable[i]) return;
       Vec3 move(0, 0, 0), around(0, 0, 0);
       int n = 0;
@@ -92,8 +103,15 @@ BondRelaxation relax_bonds(PolyMesh& dual, double bond_min, double bond_max, con
       if (n == 0) return;
       move /= n;
       move -= (move | normal[i]) * normal[i];
-      free[i] = x + kStep * move;
-      target[i] = reference.closest_point(free[i], normal[i], caches[i]);
+      // A step of at most half the rest length: no atom jumps past its neighbours.
+      const double length = kStep * move.norm();
+      free[i] = x + (length > kMaxStep * rest ? kMaxStep * rest / length : 1.0) * kStep * move;
+      const Vec3 projected = reference.closest_point(free[i], normal[i], caches[i]);
+      if (std::isfinite(free[i][0]) && std::isfinite(free[i][1]) && std::isfinite(free[i][2]) &&
+          std::isfinite(projected[0]) && std::isfinite(projected[1]) && std::isfinite(projected[2]))
+        target[i] = projected;
+      else
+        free[i] = x;
     });
     // Where the projection would put two bonded atoms in one place (a reference corner that every
     // point nearby projects to: the three centroids around a valence-3 vertex at cheese's sharp

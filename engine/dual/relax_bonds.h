@@ -10,7 +10,8 @@
 /// three bonds moves (all at once, half way) toward the mean of the points at rest length from its
 /// neighbours, along the surface only (the normal part of the move dropped), then onto the
 /// reference surface. A move that turns a dual face over (its normal against what it was) is
-/// undone. Dual vertices with fewer than three bonds (at the boundary of an open mesh) stay. The
+/// undone. Dual vertices on the dual's boundary (an open mesh's) stay; a move is at most half the
+/// rest length. The
 /// iterations stop once every bond is inside, or after kPatience without a new high of bonds
 /// inside; the positions with the most bonds inside are kept.
 /// Two bonded atoms in one place (the projection of the centroids can put the three around a
@@ -19,6 +20,7 @@
 /// projection would put them back in one place they stay off the surface by their short move.
 
 #include <cstddef>
+#include <stop_token>
 
 #include "core/mesh.h"
 
@@ -34,10 +36,12 @@ struct BondRelaxation {
   double seconds = 0;               ///< time spent
 };
 
-/// Relaxes the bonds of `dual` (a trivalent_dual() result) toward (bond_min + bond_max) / 2, its
-/// vertices kept on `reference`. At most `max_iterations`. Deterministic whatever `threads`.
+/// Relaxes the bonds of `dual` (a trivalent_dual() result) toward (bond_min + bond_max) / 2 (kept
+/// within 0.8-1.25 times the mean bond, for an interval open upward), its vertices kept on
+/// `reference`. At most `max_iterations`; a stop request ends it after the current iteration, with
+/// the best positions so far. Deterministic whatever `threads`.
 /// \pre 0 < bond_min < bond_max.
 BondRelaxation relax_bonds(PolyMesh& dual, double bond_min, double bond_max, const ReferenceSurface& reference,
-                           unsigned threads = 0, int max_iterations = 60);
+                           unsigned threads = 0, int max_iterations = 60, std::stop_token stop = {});
 
 }  // namespace remesh

@@ -137,3 +137,31 @@ TEST_CASE("atoms in one place are pushed apart", "[dual]") {
   for (auto e : dual.edges()) CHECK(dual.calc_edge_length(e) > 0.5 * rest);
   CHECK(r.inside_after == r.bonds);
 }
+
+TEST_CASE("an interval open upward or an atom whose bonds all have no length stay in bounds", "[dual]") {
+  const TriMesh mesh = test::make_icosphere(3, kRadius);
+  const ReferenceSurface reference(mesh);
+  const PolyMesh start = trivalent_dual(mesh, &reference);
+  double mean = 0, longest = 0;
+  for (auto e : start.edges()) {
+    mean += start.calc_edge_length(e) / static_cast<double>(start.n_edges());
+    longest = std::max(longest, start.calc_edge_length(e));
+  }
+  // Bonds of at least 1.2 x the mean and at most 1e300: the rest length stays near the bonds'.
+  PolyMesh wide = start;
+  const BondRelaxation r = relax_bonds(wide, 1.2 * mean, 1e300, reference);
+  CHECK(r.iterations > 0);
+  for (auto e : wide.edges()) CHECK(wide.calc_edge_length(e) < 2 * longest);
+  for (auto v : wide.vertices()) CHECK(std::abs(wide.point(v).norm() - kRadius) < 0.05);
+  // An atom and its three neighbours in one place: the atom has no direction to go at first.
+  PolyMesh lumped = start;
+  const auto a = lumped.vertex_handle(0);
+  for (auto w : lumped.vv_range(a)) lumped.point(w) = lumped.point(a);
+  relax_bonds(lumped, 0.9 * mean, 1.1 * mean, reference);
+  for (auto v : lumped.vertices()) {
+    const Vec3& p = lumped.point(v);
+    CHECK((std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2])));
+    CHECK(std::abs(p.norm() - kRadius) < 0.05);
+  }
+  for (auto e : lumped.edges()) CHECK(lumped.calc_edge_length(e) > 0.3 * mean);
+}
