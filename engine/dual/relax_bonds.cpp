@@ -54,8 +54,9 @@ BondRelaxation relax_bonds(PolyMesh& dual, double bond_min, double bond_max, con
   double sum = 0;
   for (auto e : dual.edges()) sum += dual.calc_edge_length(e);
   const double mean = r.bonds > 0 ? sum / static_cast<double>(r.bonds) : 0;
-  const double rest = std::clamp(0.5 * (bond_min + bond_max), std::max(bond_min, 0.8 * mean),
-                                 std::max(bond_min, std::min(bond_max, 1.25 * mean)));
+  const double hi = std::max(bond_min, std::min(bond_max, 1.25 * mean));
+  const double lo = std::min(hi, std::max(bond_min, 0.8 * mean));  // an interval far below the bonds: hi
+  const double rest = std::clamp(0.5 * (bond_min + bond_max), lo, hi);
   const std::size_t nv = dual.n_vertices(), nf = dual.n_faces();
   std::vector<char> movable(nv, 0);
   for (auto v : dual.vertices()) movable[v.idx()] = !dual.is_boundary(v) && dual.valence(v) == 3;

@@ -153,6 +153,11 @@ TEST_CASE("an interval open upward or an atom whose bonds all have no length sta
   CHECK(r.iterations > 0);
   for (auto e : wide.edges()) CHECK(wide.calc_edge_length(e) < 2 * longest);
   for (auto v : wide.vertices()) CHECK(std::abs(wide.point(v).norm() - kRadius) < 0.05);
+  // An interval far below the bonds (a run that did not reach it): the atoms stay on the surface.
+  PolyMesh tight = start;
+  relax_bonds(tight, 0.2 * mean, 0.3 * mean, reference);
+  for (auto v : tight.vertices()) CHECK(std::abs(tight.point(v).norm() - kRadius) < 0.05);
+  for (auto e : tight.edges()) CHECK(tight.calc_edge_length(e) > 0);
   // An atom and its three neighbours in one place: the atom has no direction to go at first.
   PolyMesh lumped = start;
   const auto a = lumped.vertex_handle(0);
