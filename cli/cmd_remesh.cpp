@@ -4,7 +4,6 @@
 
 #include <algorithm>
 #include <climits>
-#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <iostream>
@@ -188,8 +187,7 @@ int run_remesh(const std::vector<std::string>& args) {
   if (job.dual_out) {
     PolyMesh dual = trivalent_dual(mesh, &*reference);
     if (job.params.relax_dual)
-      relaxed = relax_bonds(dual, job.params.e_min / std::sqrt(3.0), job.params.e_max / std::sqrt(3.0), *reference,
-                            job.params.threads, 60, stop.get_token());
+      relaxed = relax_bonds(dual, job.params.e_min, job.params.e_max, *reference, job.params.threads, stop.get_token());
     write_mesh_file(to_soup(dual), *job.dual_out);
     if (!job.quiet) dual_summary = dual_stats(dual, job.params.e_min, job.params.e_max);  // for the summary only
   }

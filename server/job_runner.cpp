@@ -1,6 +1,5 @@
 #include "job_runner.h"
 
-#include <cmath>
 #include <stdexcept>
 
 #include "dual/relax_bonds.h"
@@ -59,8 +58,7 @@ RunOutput run_job(const remesh::api::JobRecord& job, std::string upload, unsigne
   }();
   remesh::PolyMesh dual = remesh::trivalent_dual(mesh, &reference);
   if (params.relax_dual) {
-    remesh::relax_bonds(dual, params.e_min / std::sqrt(3.0), params.e_max / std::sqrt(3.0), reference, params.threads,
-                        60, stop);
+    remesh::relax_bonds(dual, params.e_min, params.e_max, reference, params.threads, stop);
     // A stop asked for meanwhile (DELETE, shutdown) cancels the job, as during the run.
     if (stop.stop_requested()) {
       out.outcome = remesh::Outcome::Cancelled;

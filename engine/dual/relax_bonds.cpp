@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "core/parallel.h"
+#include "dual/dual_stats.h"
 #include "remesh/reference_surface.h"
 
 namespace remesh {
@@ -21,15 +22,6 @@ constexpr double kCoincident = 1e-9;
 /// The longest move per iteration, as a share of the rest length.
 constexpr double kMaxStep = 0.5;
 
-std::size_t count_inside(const PolyMesh& dual, double lo, double hi) {
-  std::size_t n = 0;
-  for (auto e : dual.edges()) {
-    const double l = dual.calc_edge_length(e);
-    n += l >= lo && l <= hi;
-  }
-  return n;
-}
-
 /// Newell's normal of a face (not normalised): robust for the dual's non-planar polygons.
 Vec3 newell_normal(const PolyMesh& dual, PolyMesh::FaceHandle f) {
   Vec3 n(0, 0, 0);
@@ -43,24 +35,24 @@ Vec3 newell_normal(const PolyMesh& dual, PolyMesh::FaceHandle f) {
 
 }  // namespace
 
-BondRelaxation relax_bonds(PolyMesh& dual, double bond_min, double bond_max, const ReferenceSurface& reference,
-                           unsigned threads, int max_iterations, std::stop_token stop) {
+BondRelaxation relax_bonds(PolyMesh& dual, double e_min, double e_max, const ReferenceSurface& reference,
+                           unsigned threads, std::stop_token stop, int max_iterations) {
   const auto start = std::chrono::steady_clock::now();
+  auto inside = [&](const DualStats& s) { return s.bonds - s.short_bonds - s.long_bonds; };
+  const DualStats first = dual_stats(dual, e_min, e_max);
   BondRelaxation r;
-  r.bonds = dual.n_edges();
-  r.inside_before = r.inside_after = count_inside(dual, bond_min, bond_max);
+  r.bonds = first.bonds;
+  r.inside_before = r.inside_after = inside(first);
+  const double bond_min = first.bond_min, bond_max = first.bond_max, mean = first.mean;
   // The rest length: the middle of the interval, but within the bonds' own range (an interval
   // open upward, e_max up to the bounding box's diagonal, would fling the atoms across the model).
-  double sum = 0;
-  for (auto e : dual.edges()) sum += dual.calc_edge_length(e);
-  const double mean = r.bonds > 0 ? sum / static_cast<double>(r.bonds) : 0;
   const double hi = std::max(bond_min, std::min(bond_max, 1.25 * mean));
   const double lo = std::min(hi, std::max(bond_min, 0.8 * mean));  // an interval far below the bonds: hi
   const double rest = std::clamp(0.5 * (bond_min + bond_max), lo, hi);
   const std::size_t nv = dual.n_vertices(), nf = dual.n_faces();
   std::vector<char> movable(nv, 0);
   for (auto v : dual.vertices()) movable[v.idx()] = !dual.is_boundary(v) && dual.valence(v) == 3;
-  std::vector<Vec3> best(nv), target(nv), free(nv), settled(nv), normal(nv), face_normal(nf);
+  std::vector<Vec3> best(nv), before(nv), target(nv), free(nv), settled(nv), normal(nv), face_normal(nf);
   std::vector<NeighbourCache> caches(nv);  // each vertex's last kd-tree answer (reference_surface.h)
   for (auto v : dual.vertices()) best[v.idx()] = dual.point(v);
   int since_best = 0;
@@ -128,7 +120,6 @@ BondRelaxation relax_bonds(PolyMesh& dual, double bond_min, double bond_max, con
     });
     for (std::size_t i = 0; i < nv; ++i)
       if (movable[i]) target[i] = settled[i];
-    std::vector<Vec3> before(nv);
     for (std::size_t i = 0; i < nv; ++i) {
       const auto v = dual.vertex_handle(static_cast<unsigned>(i));
       before[i] = dual.point(v);
@@ -144,9 +135,9 @@ BondRelaxation relax_bonds(PolyMesh& dual, double bond_min, double bond_max, con
           if (dual.point(v) != before[v.idx()]) dual.point(v) = before[v.idx()], undone = true;
       }
     }
-    const std::size_t inside = count_inside(dual, bond_min, bond_max);
-    if (inside > r.inside_after) {
-      r.inside_after = inside;
+    const std::size_t now = inside(dual_stats(dual, e_min, e_max));
+    if (now > r.inside_after) {
+      r.inside_after = now;
       since_best = 0;
       for (auto v : dual.vertices()) best[v.idx()] = dual.point(v);
     } else {

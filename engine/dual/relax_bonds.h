@@ -36,12 +36,13 @@ struct BondRelaxation {
   double seconds = 0;               ///< time spent
 };
 
-/// Relaxes the bonds of `dual` (a trivalent_dual() result) toward (bond_min + bond_max) / 2 (kept
+/// Relaxes the bonds of `dual` (a trivalent_dual() result) toward the middle of the bond interval
+/// [e_min, e_max] / sqrt(3) (the primal interval, as dual_stats() takes it; the rest length kept
 /// within 0.8-1.25 times the mean bond, for an interval open upward), its vertices kept on
 /// `reference`. At most `max_iterations`; a stop request ends it after the current iteration, with
-/// the best positions so far. Deterministic whatever `threads`.
-/// \pre 0 < bond_min < bond_max.
-BondRelaxation relax_bonds(PolyMesh& dual, double bond_min, double bond_max, const ReferenceSurface& reference,
-                           unsigned threads = 0, int max_iterations = 60, std::stop_token stop = {});
+/// the best positions so far. Deterministic whatever `threads`. The counts are dual_stats()'s.
+/// \pre 0 < e_min < e_max.
+BondRelaxation relax_bonds(PolyMesh& dual, double e_min, double e_max, const ReferenceSurface& reference,
+                           unsigned threads = 0, std::stop_token stop = {}, int max_iterations = 60);
 
 }  // namespace remesh

@@ -48,6 +48,8 @@ struct Surface {
 };
 
 constexpr double kRadius = 10, kMajor = 12, kMinor = 4;
+/// The primal interval a bond interval comes from is sqrt(3) times as long (relax_bonds takes it).
+const double kRoot3 = std::sqrt(3.0);
 
 }  // namespace
 
@@ -78,7 +80,7 @@ TEST_CASE("relaxed bonds: more inside the interval, on the surface, no face turn
     const PolyMesh centroids = trivalent_dual(mesh, &reference);
     const double lo = p.e_min / std::sqrt(3.0), hi = p.e_max / std::sqrt(3.0);
     PolyMesh relaxed = centroids;
-    const BondRelaxation r = relax_bonds(relaxed, lo, hi, reference, 1);
+    const BondRelaxation r = relax_bonds(relaxed, p.e_min, p.e_max, reference, 1);
 
     const std::size_t before = bonds_inside(centroids, lo, hi), after = bonds_inside(relaxed, lo, hi);
     INFO("bonds inside " << before << " -> " << after << " of " << relaxed.n_edges() << " in " << r.iterations
@@ -105,7 +107,7 @@ TEST_CASE("relaxed bonds: more inside the interval, on the surface, no face turn
     }
     // Whatever the thread count, the same points.
     PolyMesh again = centroids;
-    relax_bonds(again, lo, hi, reference, 2);
+    relax_bonds(again, p.e_min, p.e_max, reference, 2);
     for (auto v : relaxed.vertices()) CHECK(again.point(v) == relaxed.point(v));
   }
 }
@@ -132,7 +134,7 @@ TEST_CASE("atoms in one place are pushed apart", "[dual]") {
   const auto ring = dual.face_handle(0);
   std::vector<PolyMesh::VertexHandle> atoms(dual.fv_range(ring).begin(), dual.fv_range(ring).end());
   for (auto v : atoms) dual.point(v) = dual.point(atoms[0]);
-  const BondRelaxation r = relax_bonds(dual, 0.9 * rest, 1.1 * rest, reference);
+  const BondRelaxation r = relax_bonds(dual, 0.9 * kRoot3 * rest, 1.1 * kRoot3 * rest, reference);
   CHECK(r.iterations > 0);
   for (auto e : dual.edges()) CHECK(dual.calc_edge_length(e) > 0.5 * rest);
   CHECK(r.inside_after == r.bonds);
@@ -149,20 +151,20 @@ TEST_CASE("an interval open upward or an atom whose bonds all have no length sta
   }
   // Bonds of at least 1.2 x the mean and at most 1e300: the rest length stays near the bonds'.
   PolyMesh wide = start;
-  const BondRelaxation r = relax_bonds(wide, 1.2 * mean, 1e300, reference);
+  const BondRelaxation r = relax_bonds(wide, 1.2 * kRoot3 * mean, 1e300, reference);
   CHECK(r.iterations > 0);
   for (auto e : wide.edges()) CHECK(wide.calc_edge_length(e) < 2 * longest);
   for (auto v : wide.vertices()) CHECK(std::abs(wide.point(v).norm() - kRadius) < 0.05);
   // An interval far below the bonds (a run that did not reach it): the atoms stay on the surface.
   PolyMesh tight = start;
-  relax_bonds(tight, 0.2 * mean, 0.3 * mean, reference);
+  relax_bonds(tight, 0.2 * kRoot3 * mean, 0.3 * kRoot3 * mean, reference);
   for (auto v : tight.vertices()) CHECK(std::abs(tight.point(v).norm() - kRadius) < 0.05);
   for (auto e : tight.edges()) CHECK(tight.calc_edge_length(e) > 0);
   // An atom and its three neighbours in one place: the atom has no direction to go at first.
   PolyMesh lumped = start;
   const auto a = lumped.vertex_handle(0);
   for (auto w : lumped.vv_range(a)) lumped.point(w) = lumped.point(a);
-  relax_bonds(lumped, 0.9 * mean, 1.1 * mean, reference);
+  relax_bonds(lumped, 0.9 * kRoot3 * mean, 1.1 * kRoot3 * mean, reference);
   for (auto v : lumped.vertices()) {
     const Vec3& p = lumped.point(v);
     CHECK((std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2])));
