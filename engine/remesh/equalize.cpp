@@ -234,7 +234,7 @@ std::size_t final_patch_budget(const TriMesh& mesh) { return std::max<std::size_
 /// (kFinalCleanupRounds, final_patch_budget).
 CleanupCounts run_cleanup(TriMesh& mesh, const ReferenceSurface& reference, const Params& params,
                           std::vector<NeighbourCache>& caches, const CreaseGuard* creases, bool final,
-                          bool boundary_only = false, std::stop_token stop = {}) {
+                          bool boundary_only = false, std::stop_token stop = {}, PatchRest* rest = nullptr) {
   CleanupOptions options;
   options.rounds = final ? kFinalCleanupRounds : kCleanupRounds;
   if (final) options.patch_budget = final_patch_budget(mesh);
@@ -243,6 +243,7 @@ CleanupCounts run_cleanup(TriMesh& mesh, const ReferenceSurface& reference, cons
   options.protect_tips = params.protect_tips;
   options.stop = std::move(stop);
   options.creases = creases;
+  options.rest = final ? nullptr : rest;
   return interval_cleanup(mesh, reference, params.e_min, params.e_max, params.flip_factor, options);
 }
 
@@ -498,6 +499,7 @@ Result equalize(TriMesh& mesh, const Params& requested, const OnIteration& on_it
     return !params.keep_creases || lines.empty() ? nullptr : std::make_unique<CreaseGuard>(lines, on_crease);
   };
   std::unique_ptr<CreaseGuard> guard = guard_of(*creases);
+  PatchRest patch_rest(mesh);  // the per-iteration cleanups' memory of failed patch relaxations
   setup_timer.stop();
 
   std::vector<IterationStats> history;  // the row of each iteration (plateaued)
@@ -628,7 +630,7 @@ Result equalize(TriMesh& mesh, const Params& requested, const OnIteration& on_it
       if (full || reference->has_boundary()) {
         const PhaseTimer timer(phases.cleanup);
         const CleanupCounts c = run_cleanup(mesh, *reference, params, neighbour_caches, guard.get(), /*final=*/false,
-                                            /*boundary_only=*/!full, stop);
+                                            /*boundary_only=*/!full, stop, &patch_rest);
         count_cleanup(counters, c);
         renumbered_since += c.splits + c.collapses;
       }

@@ -156,7 +156,7 @@ class Cleanup {
         ++counts.splits;
       } else if (try_relocate(e)) {
         ++counts.relocations;
-      } else if (patch_budget_ > 0 && !patch_failed(e) && (--patch_budget_, try_relax_patch(e))) {
+      } else if (patch_budget_ > 0 && !patch_failed(e) && (--patch_budget_, try_relax_patch(e, counts))) {
         ++counts.patches;
       } else {
         // A failure counts only with the patch relaxation tried, or out of budget for good: a
@@ -178,6 +178,7 @@ class Cleanup {
   bool stop_requested() const { return stop_.stop_requested(); }
   void set_remember_failures(bool on) { remember_failures_ = on; }
   void set_protect_tips(bool on) { protect_tips_ = on; }
+  void set_rest(PatchRest* rest) { rest_ = rest; }
   void set_creases(const CreaseGuard* creases) { creases_ = creases && !creases->empty() ? creases : nullptr; }
 
   NeighbourCache* cache_of(VertexHandle v) {
@@ -542,11 +543,17 @@ class Cleanup {
   /// edges lie outside the interval, or as many but with 10 % less squared excess; else every
   /// vertex goes back. (An edge of 1.98 between six regular vertices cannot be split, its halves
   /// would be short, nor fixed by moving one end, whose other edges are at their limits.)
-  bool try_relax_patch(EdgeHandle e) {
+  bool try_relax_patch(EdgeHandle e, CleanupCounts& counts) {
     const HalfedgeHandle h = mesh_.halfedge_handle(e, 0);
-    if (relax_patch({mesh_.from_vertex_handle(h), mesh_.to_vertex_handle(h)}, VertexHandle(), Vec3(0, 0, 0), false))
-      return true;
+    const VertexHandle a = mesh_.from_vertex_handle(h), b = mesh_.to_vertex_handle(h);
+    if (rest_ && rest_->resting(a, b)) {
+      ++counts.rested;
+      failed_patches_.push_back(e.idx());
+      return false;
+    }
+    if (relax_patch({a, b}, VertexHandle(), Vec3(0, 0, 0), false)) return true;
     failed_patches_.push_back(e.idx());
+    if (rest_) rest_->failed(a, b);
     return false;
   }
 
@@ -716,6 +723,7 @@ class Cleanup {
   /// another vertex (after a renumbering) still gives an exact answer (reference_surface.h).
   std::vector<NeighbourCache>* caches_;
   std::vector<int> failed_patches_;           ///< edges whose patch relaxation failed (patch_failed)
+  PatchRest* rest_ = nullptr;                 ///< CleanupOptions::rest
   bool remember_failures_ = true;             ///< CleanupOptions::remember_failures
   std::uint32_t clock_ = 0;                   ///< ticks once per fix (failure memory)
   /// Stamps not yet handed on (spread_stamps): vertex index and tick.
@@ -744,6 +752,31 @@ std::size_t snap_to_features(TriMesh& mesh, const ReferenceSurface& reference, d
   return moved;
 }
 
+PatchRest::~PatchRest() {
+  OpenMesh::VPropHandleT<Failures> at;
+  if (mesh_.get_property_handle(at, kName)) mesh_.remove_property(at);
+}
+
+void PatchRest::begin() {
+  if (!mesh_.get_property_handle(at_, kName)) mesh_.add_property(at_, kName);
+  ++cleanup_;
+}
+
+bool PatchRest::resting(VertexHandle a, VertexHandle b) const {
+  const std::uint32_t before = cleanup_ - 1;
+  const Failures &x = mesh_.property(at_, a), &y = mesh_.property(at_, b);
+  return before > 0 && x.at == before && y.at == before && x.row >= kRow && y.row >= kRow;
+}
+
+void PatchRest::failed(VertexHandle a, VertexHandle b) {
+  for (auto v : {a, b}) {
+    Failures& f = mesh_.property(at_, v);
+    if (f.at == cleanup_) continue;
+    f.row = f.at > 0 && cleanup_ - f.at <= 2 ? f.row + 1 : 1;  // 2: the cleanup before was a rest
+    f.at = cleanup_;
+  }
+}
+
 CleanupCounts interval_cleanup(TriMesh& mesh, const ReferenceSurface& reference, double e_min, double e_max,
                                double flip_factor, const CleanupOptions& options) {
   Cleanup cleanup(mesh, reference, e_min, e_max, flip_factor, options.caches);
@@ -752,6 +785,8 @@ CleanupCounts interval_cleanup(TriMesh& mesh, const ReferenceSurface& reference,
   cleanup.set_protect_tips(options.protect_tips);
   cleanup.set_creases(options.creases);
   cleanup.set_stop(options.stop);
+  if (options.rest) options.rest->begin();
+  cleanup.set_rest(options.rest);
   CleanupCounts counts;
   counts.outside_before = cleanup.count_outside();
   if (counts.outside_before > 0)

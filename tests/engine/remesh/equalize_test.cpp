@@ -494,6 +494,10 @@ TEST_CASE("a stalled run returns the mesh with the fewest edges outside", "[equa
     std::size_t low = SIZE_MAX;
     for (std::size_t i = first_cleanup; i + 1 < rows.size(); ++i) low = std::min(low, rows[i].small + rows[i].big);
     CHECK(outside <= low);
+    // The per-iteration cleanups' memory (PatchRest) leaves nothing on the returned mesh.
+    CHECK(std::none_of(mesh.vprops_begin(), mesh.vprops_end(), [](const OpenMesh::BaseProperty* p) {
+      return p && p->name() == "remesh:patch_failed";
+    }));
   }
 }
 

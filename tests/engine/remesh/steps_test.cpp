@@ -1025,3 +1025,72 @@ TEST_CASE("the cleanup's failure memory changes nothing but the work", "[steps]"
   }
   CHECK(skipped > 0);  // the memory was used
 }
+
+TEST_CASE("a patch relaxation that failed in two cleanups in a row rests for one", "[steps]") {
+  // The memory alone: an edge whose ends both had failures in the last two cleanups (a rest
+  // between two does not break the row) rests in the next cleanup, then is tried again; a failure
+  // at one end rests nothing; a mesh rebuilt from scratch starts afresh.
+  auto has_memory = [](const TriMesh& m) {
+    return std::any_of(m.vprops_begin(), m.vprops_end(),
+                       [](const OpenMesh::BaseProperty* p) { return p && p->name() == "remesh:patch_failed"; });
+  };
+  TriMesh mesh = test::make_icosphere(2, 1.0);
+  const auto a = mesh.vertex_handle(0), b = mesh.vertex_handle(1), c = mesh.vertex_handle(2);
+  {
+    PatchRest rest(mesh);
+    rest.begin();  // 1
+    CHECK(has_memory(mesh));
+    CHECK_FALSE(rest.resting(a, b));
+    rest.failed(a, b);
+    rest.begin();  // 2
+    CHECK_FALSE(rest.resting(a, b));  // one failure
+    rest.failed(a, b);
+    rest.failed(a, c);
+    rest.begin();  // 3
+    CHECK(rest.resting(a, b));
+    CHECK(rest.resting(b, a));
+    CHECK_FALSE(rest.resting(a, c));  // c failed once
+    rest.begin();  // 4: rested in 3, tried again
+    CHECK_FALSE(rest.resting(a, b));
+    rest.failed(a, b);
+    rest.begin();  // 5: the row goes on across the rest
+    CHECK(rest.resting(a, b));
+    rest.begin();  // 6
+    rest.begin();  // 7: nothing failed in 6
+    CHECK_FALSE(rest.resting(a, b));
+    free_mesh(mesh);
+    mesh = test::make_icosphere(2, 1.0);
+    CHECK_FALSE(has_memory(mesh));
+    rest.begin();
+    CHECK_FALSE(rest.resting(a, b));
+  }
+  CHECK_FALSE(has_memory(mesh));
+
+  // In the cleanup: a thin jittered tube, whose edges no fix can all mend. Cleanups in a row with
+  // the memory rest patches from the third on, each resting one from the budget; the mesh stays
+  // valid and on the reference.
+  std::mt19937 rng(11);
+  std::normal_distribution<double> jitter(0.0, 0.05);
+  const TriMesh tube = test::make_torus(70, 10, 7.0, 0.45);
+  const ReferenceSurface reference(tube);
+  TriMesh thin = test::make_torus(30, 4, 7.0, 0.45);
+  for (auto v : thin.vertices()) thin.point(v) += Vec3(jitter(rng), jitter(rng), jitter(rng));
+  project_onto_reference(thin, reference, 2);
+  REQUIRE(test::check_mesh_valid(thin) == "");
+  PatchRest rest(thin);
+  CleanupOptions options;
+  options.rest = &rest;
+  options.patch_budget = 8;
+  std::size_t rested = 0;
+  for (int i = 0; i < 6; ++i) {
+    CAPTURE(i);
+    const CleanupCounts counts = interval_cleanup(thin, reference, 1.2, 1.8, 0.5, options);
+    if (i < 2) CHECK(counts.rested == 0);
+    CHECK(counts.patches + counts.rested <= options.patch_budget);
+    rested += counts.rested;
+    CHECK(counts.outside_after > 0);
+    CHECK(test::check_mesh_valid(thin) == "");
+    for (auto v : thin.vertices()) CHECK(test::brute_distance(tube, thin.point(v)) < 1e-6);
+  }
+  CHECK(rested > 0);
+}
