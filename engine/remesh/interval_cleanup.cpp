@@ -753,12 +753,17 @@ std::size_t snap_to_features(TriMesh& mesh, const ReferenceSurface& reference, d
 }
 
 PatchRest::~PatchRest() {
-  OpenMesh::VPropHandleT<Failures> at;
-  if (mesh_.get_property_handle(at, kName)) mesh_.remove_property(at);
+  try {
+    OpenMesh::VPropHandleT<Failures> at;
+    if (mesh_.get_property_handle(at, kName)) mesh_.remove_property(at);
+  } catch (...) {  // the name's string could not be allocated: the property stays, harmless
+  }
 }
 
 void PatchRest::begin() {
-  if (!mesh_.get_property_handle(at_, kName)) mesh_.add_property(at_, kName);
+  const bool found = mesh_.get_property_handle(at_, kName);
+  if (found && cleanup_ == 0) mesh_.remove_property(at_);  // another run's, whose numbers are not ours
+  if (!found || cleanup_ == 0) mesh_.add_property(at_, kName);
   ++cleanup_;
 }
 
@@ -772,7 +777,7 @@ void PatchRest::failed(VertexHandle a, VertexHandle b) {
   for (auto v : {a, b}) {
     Failures& f = mesh_.property(at_, v);
     if (f.at == cleanup_) continue;
-    f.row = f.at > 0 && cleanup_ - f.at <= 2 ? f.row + 1 : 1;  // 2: the cleanup before was a rest
+    f.row = f.at > 0 && cleanup_ - f.at <= 2 ? f.row + 1 : 1;  // at most two apart: the row goes on
     f.at = cleanup_;
   }
 }

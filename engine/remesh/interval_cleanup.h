@@ -43,12 +43,16 @@ struct CleanupCounts {
 
 /// Where patch relaxations failed, across the per-iteration cleanups of one run (CleanupOptions::
 /// rest). Each vertex holds the last cleanup in which the patch relaxation of one of its edges
-/// failed, and how many cleanups in a row had such a failure. A cleanup passes over the patch of
-/// an edge whose two ends both failed in the cleanup before it and in kRow cleanups in a row
-/// (a rest between two does not break the row), at the cost of one from the budget as the failure
-/// would have taken: it rests every other cleanup. Kept as a vertex property of the mesh, so that
-/// it follows the vertices through garbage collection; a mesh rebuilt from scratch (spatial_order,
-/// a snapshot) starts with none. The run's mesh is returned without it.
+/// failed, and the length of its row of such cleanups (a row: cleanups with a failure at most two
+/// apart, so that the rest between two does not break it; a success or an edge not tried in
+/// between does not either). A cleanup passes over the patch of an edge whose two ends both failed
+/// in the cleanup before it, in rows of at least kRow, at the cost of one from the budget as the
+/// failure would have taken: a patch that keeps failing rests every other cleanup. The memory is
+/// per vertex, not per edge: the ends may have failed through other edges of theirs; and an end
+/// that fails again within the cleanup no longer rests its edges there (more tries, never fewer).
+/// Kept as a vertex property of the mesh, so that it follows the vertices through garbage
+/// collection; a mesh rebuilt from scratch (spatial_order, a snapshot) starts with none. The run's
+/// mesh is returned without it.
 /// Why: a run that stalls (edges where the input is thinner than the interval allows) spends its
 /// per-iteration cleanups on the same patches, which fail again: cheese refined, iterations
 /// 13-24, 59 of each cleanup's 64 patches had failed at the same edge the iteration before, and 3
@@ -67,22 +71,24 @@ class PatchRest {
   ~PatchRest();
   PatchRest(const PatchRest&) = delete;
   PatchRest& operator=(const PatchRest&) = delete;
-  /// Starts the next cleanup (adds the property if the mesh has none).
+  /// Starts the next cleanup (adds the property if the mesh has none; the first call replaces one
+  /// the mesh came with).
   void begin();
   /// Did a patch relaxation fail at both a and b in the cleanup before this one?
   bool resting(OpenMesh::VertexHandle a, OpenMesh::VertexHandle b) const;
   /// A patch relaxation of the edge ab failed in this cleanup.
   void failed(OpenMesh::VertexHandle a, OpenMesh::VertexHandle b);
 
- private:
+  /// The property's name and record: a vertex's failures, the cleanup of the last (numbered from 1
+  /// by begin()) and the length of its row.
   static constexpr const char* kName = "remesh:patch_failed";
-  /// Failures in a row at both ends before an edge's patch rests.
-  static constexpr std::uint32_t kRow = 2;
-  /// A vertex's failures: the cleanup of the last, and how many cleanups in a row (a rest between
-  /// two does not break the row) had one.
   struct Failures {
     std::uint32_t at = 0, row = 0;
   };
+
+ private:
+  /// Failures in a row at both ends before an edge's patch rests.
+  static constexpr std::uint32_t kRow = 2;
   TriMesh& mesh_;
   OpenMesh::VPropHandleT<Failures> at_;
   std::uint32_t cleanup_ = 0;

@@ -13,6 +13,7 @@
 #include "remesh/equalize.h"
 #include "remesh/feature_snap.h"
 #include "remesh/geometry.h"
+#include "remesh/interval_cleanup.h"
 #include "remesh/self_intersections.h"
 #include "support/mesh_generators.h"
 #include "test_helpers.h"
@@ -494,11 +495,26 @@ TEST_CASE("a stalled run returns the mesh with the fewest edges outside", "[equa
     std::size_t low = SIZE_MAX;
     for (std::size_t i = first_cleanup; i + 1 < rows.size(); ++i) low = std::min(low, rows[i].small + rows[i].big);
     CHECK(outside <= low);
-    // The per-iteration cleanups' memory (PatchRest) leaves nothing on the returned mesh.
-    CHECK(std::none_of(mesh.vprops_begin(), mesh.vprops_end(), [](const OpenMesh::BaseProperty* p) {
-      return p && p->name() == "remesh:patch_failed";
-    }));
   }
+}
+
+TEST_CASE("the cleanups' patch memory is on the mesh during a run and gone after it", "[equalize]") {
+  // All iterations without early cleanups: the per-iteration cleanup runs in the last iteration
+  // with the memory (PatchRest), and the run returns that mesh itself (no snapshot restored).
+  auto has_memory = [](const TriMesh& m) {
+    return std::any_of(m.vprops_begin(), m.vprops_end(), [](const OpenMesh::BaseProperty* p) {
+      return p && p->name() == PatchRest::kName;
+    });
+  };
+  TriMesh mesh = test::make_torus(40, 12, 5.0, 0.6);  // thin: edges stay outside
+  Params params = table_4_2(6);
+  params.run_all_iterations = true;
+  bool during = false;
+  const Result result = equalize(mesh, params, [&](const IterationStats&) { during = during || has_memory(mesh); });
+  CHECK(result.outcome == Outcome::Completed);
+  CHECK(during);
+  CHECK_FALSE(has_memory(mesh));
+  CHECK(test::check_mesh_valid(mesh) == "");
 }
 
 TEST_CASE("the same input gives bit-identical output with 1 and 2 threads", "[equalize]") {

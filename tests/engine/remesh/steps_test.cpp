@@ -1062,9 +1062,53 @@ TEST_CASE("a patch relaxation that failed in two cleanups in a row rests for one
     mesh = test::make_icosphere(2, 1.0);
     CHECK_FALSE(has_memory(mesh));
     rest.begin();
+    CHECK(has_memory(mesh));
     CHECK_FALSE(rest.resting(a, b));
   }
   CHECK_FALSE(has_memory(mesh));
+  {
+    // A mesh that comes with the property (another run's numbers): the first begin() drops them.
+    OpenMesh::VPropHandleT<PatchRest::Failures> old;
+    mesh.add_property(old, PatchRest::kName);
+    mesh.property(old, a) = mesh.property(old, b) = PatchRest::Failures{1, 5};
+    PatchRest rest(mesh);
+    rest.begin();  // 1
+    rest.begin();  // 2: a and b would rest with the old numbers
+    CHECK_FALSE(rest.resting(a, b));
+  }
+  CHECK_FALSE(has_memory(mesh));
+  {
+    // The memory follows its vertices through garbage collection; new vertices start with none.
+    PatchRest rest(mesh);
+    rest.begin();
+    const Vec3 pa = mesh.point(a), pb = mesh.point(b);
+    rest.failed(a, b);
+    rest.begin();
+    rest.failed(a, b);
+    rest.begin();
+    const auto far = mesh.vertex_handle(static_cast<unsigned>(mesh.n_vertices() - 1));
+    REQUIRE(far != a);
+    REQUIRE(far != b);
+    // Collapse an edge away from a and b, then renumber.
+    OpenMesh::HalfedgeHandle gone;
+    for (auto h : mesh.voh_range(far))
+      if (mesh.to_vertex_handle(h) != a && mesh.to_vertex_handle(h) != b && mesh.is_collapse_ok(h)) gone = h;
+    REQUIRE(gone.is_valid());
+    const OpenMesh::VertexHandle remover = mesh.from_vertex_handle(gone);
+    mesh.collapse(gone);
+    collect_garbage(mesh);
+    (void)remover;
+    OpenMesh::VertexHandle na, nb;
+    for (auto v : mesh.vertices()) {
+      if (mesh.point(v) == pa) na = v;
+      if (mesh.point(v) == pb) nb = v;
+    }
+    REQUIRE(na.is_valid());
+    REQUIRE(nb.is_valid());
+    CHECK(rest.resting(na, nb));
+    const auto fresh = mesh.add_vertex(Vec3(9, 9, 9));
+    CHECK_FALSE(rest.resting(na, fresh));
+  }
 
   // In the cleanup: a thin jittered tube, whose edges no fix can all mend. Cleanups in a row with
   // the memory rest patches from the third on, each resting one from the budget; the mesh stays
