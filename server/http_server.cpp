@@ -216,6 +216,14 @@ void HttpServer::Impl::setup() {
     if (res.status == 200 && !req.ranges.empty() &&
         (res.has_header("Content-Range") || res.get_header_value("Content-Type").starts_with("multipart/byteranges")))
       res.status = 206;
+    // A range past the end: cpp-httplib 0.11 clears the body, sets 416 and a Content-Length of 0
+    // after the error handler has run. Say which range, as every other error does.
+    if (res.status == 416 && res.body.empty()) {
+      send_problem(res, 416, "the requested range '" + req.get_header_value("Range") + "' starts past the end of " +
+                                 req.path);
+      res.headers.erase("Content-Length");
+      res.set_header("Content-Length", std::to_string(res.body.size()));
+    }
     cors_headers(res);
     res.set_header("X-Content-Type-Options", "nosniff");
   });
