@@ -70,14 +70,29 @@ void send_json(httplib::Response& res, int status, const json& body) {
   res.set_content(body.dump(-1, ' ', false, json::error_handler_t::replace), "application/json");
 }
 
+/// The problem document this thread last answered, whole: cpp-httplib 0.11 cuts a request's byte
+/// ranges out of every answer, an error's too ("Range: bytes=0-5" on a 404 gave `{"deta`); the
+/// post-routing handler puts it back. Reset when a request is routed.
+struct LastProblem {
+  int status = 0;
+  std::string body;
+};
+thread_local LastProblem t_problem;
+
 void send_problem(httplib::Response& res, const Problem& p) {
   res.status = p.status;
-  res.set_content(p.body.dump(-1, ' ', false, json::error_handler_t::replace), "application/problem+json");
+  t_problem = {p.status, p.body.dump(-1, ' ', false, json::error_handler_t::replace)};
+  res.set_content(t_problem.body, "application/problem+json");
 }
 
 void send_problem(httplib::Response& res, int status, const std::string& detail,
                   const std::vector<FieldError>& errors = {}) {
   send_problem(res, make_problem(status, detail, errors));
+}
+
+std::string range_problem(const httplib::Request& req) {
+  return "the Range header '" + req.get_header_value("Range") + "' is malformed or starts past the end of " +
+         req.path;
 }
 
 bool constant_time_equal(const std::string& a, const std::string& b) {
@@ -195,6 +210,7 @@ void HttpServer::Impl::setup() {
 
   server.set_pre_routing_handler([this](const httplib::Request& req, httplib::Response& res) {
     t_request_start = std::chrono::steady_clock::now();
+    t_problem = {};
     if (req.method == "OPTIONS" && !options.cors_origin.empty()) {
       res.status = 204;
       res.set_header("Access-Control-Allow-Methods", "GET, POST, DELETE, OPTIONS");
@@ -216,11 +232,16 @@ void HttpServer::Impl::setup() {
     if (res.status == 200 && !req.ranges.empty() &&
         (res.has_header("Content-Range") || res.get_header_value("Content-Type").starts_with("multipart/byteranges")))
       res.status = 206;
-    // A range past the end: cpp-httplib 0.11 clears the body, sets 416 and a Content-Length of 0
-    // after the error handler has run. Say which range, as every other error does.
-    if (res.status == 416 && res.body.empty()) {
-      send_problem(res, 416, "the requested range '" + req.get_header_value("Range") + "' starts past the end of " +
-                                 req.path);
+    // An error is answered whole, whatever byte ranges the request asked for (see t_problem). A
+    // range past the end of an answer: cpp-httplib 0.11 clears the body, sets 416 and a
+    // Content-Length of 0 after the error handler has run; say which range, as every error does.
+    if (res.status >= 400 && (!req.ranges.empty() || res.status == 416)) {
+      if (t_problem.status == res.status) {
+        res.set_content(t_problem.body, "application/problem+json");
+      } else if (res.status == 416) {
+        send_problem(res, 416, range_problem(req));
+      }
+      res.headers.erase("Content-Range");
       res.headers.erase("Content-Length");
       res.set_header("Content-Length", std::to_string(res.body.size()));
     }
@@ -239,6 +260,7 @@ void HttpServer::Impl::setup() {
         if (req.get_header_value("Content-Type").find("multipart/form-data") != std::string::npos)
           detail += " (multipart/form-data: nothing may follow the boundary parameter, e.g. no '; charset=')";
         break;
+      case 416: detail = range_problem(req); break;
       default: detail = remesh::api::status_title(res.status);
     }
     send_problem(res, make_problem(res.status, detail));

@@ -481,4 +481,26 @@ TEST_CASE("remeshd: parameters and names that once crashed the service or gave 5
           std::string::npos);
   }
   CHECK(size > 0);
+  // An error is answered whole, whatever the range asked (cpp-httplib cut the problem document of
+  // a 404 to `{"deta`); a malformed Range gets a 416 that names it.
+  for (const std::string& range : {std::string("bytes=0-5"), std::string("bytes=0-5,10-20")}) {
+    for (const std::string& path : {std::string("/api/v1/nope"), std::string("/api/v1/jobs/abc")}) {
+      CAPTURE(range, path);
+      auto missing = c.Get(path.c_str(), {{"Range", range}});
+      REQUIRE(missing);
+      CHECK(missing->status == 404);
+      CHECK(missing->get_header_value("Content-Type") == "application/problem+json");
+      CHECK_FALSE(missing->has_header("Content-Range"));
+      const auto problem = nlohmann::json::parse(missing->body, nullptr, false);
+      REQUIRE(problem.is_object());
+      CHECK(problem["status"] == 404);
+    }
+  }
+  auto malformed = c.Get("/api/v1/jobs", {{"Range", "bytes=zz"}});
+  REQUIRE(malformed);
+  CHECK(malformed->status == 416);
+  const auto problem = nlohmann::json::parse(malformed->body, nullptr, false);
+  REQUIRE(problem.is_object());
+  CHECK(problem["title"] == "Range Not Satisfiable");
+  CHECK(problem["detail"].get<std::string>().find("'bytes=zz'") != std::string::npos);
 }
