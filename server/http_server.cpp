@@ -354,8 +354,16 @@ void HttpServer::Impl::post_job(const httplib::Request& req, httplib::Response& 
     }
     return total <= limit + kDrainBytes;  // past this, stop reading and close
   };
-  bool ok;
-  if (req.is_multipart_form_data()) {
+  bool ok = true;
+  // A request with neither Content-Length nor Transfer-Encoding has no body (RFC 9112 6.3), and
+  // the reader would wait for one until the client closed or the read timed out (cpp-httplib 0.11:
+  // 'curl -X POST' without a file got its error after 30 s). Nothing to read: the checks below
+  // say what is missing.
+  const bool has_body = req.has_header("Content-Length") || req.has_header("Transfer-Encoding");
+  if (!has_body) {
+    filename = req.get_param_value("filename");
+    part_type = req.get_header_value("Content-Type");
+  } else if (req.is_multipart_form_data()) {
     ok = reader(
         [&](const httplib::MultipartFormData& header) {
           part = header.name;

@@ -76,6 +76,10 @@ struct SseStream {
 };
 SseStream read_events(int port, const std::string& path, const httplib::Headers& headers = {}, double timeout = 60);
 
+/// Sends `request` (raw bytes: a request line, headers, maybe a body) to 127.0.0.1:`port` and
+/// returns what the server answers until it closes or sends nothing for `timeout` seconds.
+std::string raw_exchange(int port, const std::string& request, double timeout);
+
 /// Files (recursively) under a directory.
 std::size_t count_files(const std::filesystem::path& dir);
 
