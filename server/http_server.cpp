@@ -260,6 +260,7 @@ void HttpServer::Impl::setup() {
         if (req.get_header_value("Content-Type").find("multipart/form-data") != std::string::npos)
           detail += " (multipart/form-data: nothing may follow the boundary parameter, e.g. no '; charset=')";
         break;
+      case 414: detail = "the request's URI is longer than the server reads (8 KiB): send parameters in the body"; break;
       case 416: detail = range_problem(req); break;
       default: detail = remesh::api::status_title(res.status);
     }

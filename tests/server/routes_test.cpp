@@ -504,6 +504,10 @@ TEST_CASE("remeshd: parameters and names that once crashed the service or gave 5
   INFO(answer);
   CHECK(answer.rfind("HTTP/1.1 422", 0) == 0);
   CHECK(answer.find("\"field\":\"mesh\"") != std::string::npos);
+  auto too_long = c.Get(("/api/v1/jobs?" + std::string(20000, 'a') + "=1").c_str());
+  REQUIRE(too_long);
+  CHECK(too_long->status == 414);
+  CHECK(nlohmann::json::parse(too_long->body)["detail"].get<std::string>().find("URI is longer") != std::string::npos);
   auto malformed = c.Get("/api/v1/jobs", {{"Range", "bytes=zz"}});
   REQUIRE(malformed);
   CHECK(malformed->status == 416);
