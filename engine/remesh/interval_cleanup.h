@@ -36,8 +36,8 @@ struct CleanupCounts {
   std::size_t outside_before = 0, outside_after = 0;  ///< edges outside [e_min, e_max]
   /// Edges passed over because no fix could mend them last time and nothing near them changed.
   std::size_t skipped = 0;
-  /// Patch relaxations passed over because they failed at the edge's ends in the cleanup before
-  /// (CleanupOptions::rest); each took one from the budget, as the failure it stands for would.
+  /// Patch relaxations passed over because the edge's ends keep failing (PatchRest, through
+  /// CleanupOptions::rest); each took one from the budget, as the failure it stands for would.
   std::size_t rested = 0;
 };
 
@@ -60,7 +60,7 @@ struct CleanupCounts {
 /// so resting one changes the run only where it would have succeeded. Measured (bench --spread,
 /// 2 threads, each mesh-setup's five intervals run in turn with and without, twice): the eight
 /// stalled mesh-setups (cheese, cow and camelhead both ways, bunny and spot simplified) 8.6 and
-/// 5.6 % less time (cheese and cow simplified 16 and 15 %), inside -0.01 points on average (16
+/// 5.6 % less time (cheese simplified 16 %, cow simplified 13-15 %), inside -0.01 points on average (16
 /// runs better, 13 worse of 40), Hausdorff 2.5 % more (geometric mean), crossing face pairs 491
 /// against 535. Resting after one failure instead changed the runs that converge (armadillo
 /// refined took 1-2 more iterations on 3 of 5 intervals); after two it gives the same meshes
