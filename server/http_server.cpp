@@ -315,6 +315,17 @@ void HttpServer::Impl::setup() {
   server.Get(job_path + "/result", guard([this](const auto& req, auto& res) { result(req, res); }));
   server.Get(job_path + "/stats", guard([this](const auto& req, auto& res) { stats(req, res); }));
   server.Get("/.*", guard([this](const auto& req, auto& res) { static_files(req, res); }));
+  // Any other POST, PUT or PATCH: no such route. Routed with a content reader so that a request
+  // without a body is answered at once (cpp-httplib 0.11 otherwise waits for a body that has no
+  // length until its read timeout, 30 s); a body, if any, is read and dropped.
+  auto no_route = [](const httplib::Request& req, httplib::Response& res, const httplib::ContentReader& reader) {
+    if (req.has_header("Content-Length") || req.has_header("Transfer-Encoding"))
+      if (!reader([](const char*, std::size_t) { return true; })) res.set_header("Connection", "close");
+    send_problem(res, 404, "no such route: " + req.method + " " + req.path);
+  };
+  server.Post("/.*", no_route);
+  server.Put("/.*", no_route);
+  server.Patch("/.*", no_route);
 }
 
 void HttpServer::Impl::health(const httplib::Request&, httplib::Response& res) {

@@ -504,6 +504,20 @@ TEST_CASE("remeshd: parameters and names that once crashed the service or gave 5
   INFO(answer);
   CHECK(answer.rfind("HTTP/1.1 422", 0) == 0);
   CHECK(answer.find("\"field\":\"mesh\"") != std::string::npos);
+  for (const std::string method : {"POST", "PUT", "PATCH"}) {
+    const std::string other =
+        raw_exchange(d.port(), method + " /api/v1/nope HTTP/1.1\r\nHost: x\r\nConnection: close\r\n\r\n", 10);
+    INFO(other);
+    CHECK(other.rfind("HTTP/1.1 404", 0) == 0);
+    CHECK(other.find("no such route: " + method + " /api/v1/nope") != std::string::npos);
+  }
+  // With a body, the body is read and dropped, and the connection serves the next request.
+  auto with_body = c.Put("/api/v1/jobs", std::string(5000, 'x'), "text/plain");
+  REQUIRE(with_body);
+  CHECK(with_body->status == 404);
+  auto next = c.Get("/api/v1/jobs");
+  REQUIRE(next);
+  CHECK(next->status == 200);
   auto too_long = c.Get(("/api/v1/jobs?" + std::string(20000, 'a') + "=1").c_str());
   REQUIRE(too_long);
   CHECK(too_long->status == 414);
