@@ -1,7 +1,11 @@
 /// \file common.cpp
 /// Helpers shared by the commands.
 
+#include <unistd.h>
+
+#include <cerrno>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <ostream>
 
@@ -30,6 +34,18 @@ Format require_output_format(const std::string& path) {
   std::error_code ec;
   if (!dir.empty() && !std::filesystem::is_directory(dir, ec))
     throw UsageError("output directory does not exist: " + dir.string());
+  if (std::filesystem::is_directory(path, ec)) throw UsageError("output is a directory: " + path);
+  // ... and take a file: a file created there and removed at once (a read-only or special file
+  // system, or a directory without write permission, refused the output only after the run).
+  const std::string probe = path + ".remesh-probe-" + std::to_string(::getpid());
+  if (std::FILE* f = std::fopen(probe.c_str(), "wx")) {
+    std::fclose(f);
+    std::remove(probe.c_str());
+  } else {
+    const int error = errno;
+    throw UsageError("cannot write to the output directory " + (dir.empty() ? std::string(".") : dir.string()) +
+                     ": " + std::strerror(error));
+  }
   return *format;
 }
 

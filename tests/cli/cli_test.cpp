@@ -120,6 +120,11 @@ TEST_CASE("bad arguments exit with 2 and one line on stderr", "[cli]") {
       {{"convert", mesh, dir.file("out.xyzzy")}, "out.xyzzy"},
       {{"convert", mesh, dir.file("out.gltf")}, ".glb"},
       {{"convert", mesh, dir.file("no_such_dir/out.obj")}, "no_such_dir"},
+      // Found before the work, not after it: an output that is a directory, and a directory that
+      // takes no file (/proc: even root cannot create one there).
+      {{"convert", mesh, dir.file("taken.obj")}, "output is a directory"},
+      {{"convert", mesh, "/proc/out.obj"}, "cannot write to the output directory /proc"},
+      {{"dual", mesh, "/proc/d.obj"}, "/proc"},
       {{"dual", dir.file("missing.obj"), dir.file("d.obj")}, "missing.obj"},
       {{"frobnicate"}, "frobnicate"},
   };
@@ -134,6 +139,11 @@ TEST_CASE("bad arguments exit with 2 and one line on stderr", "[cli]") {
   cases.push_back({{dir.file("missing.obj"), out, "--emin", "0.2", "--emax", "0.3"}, "missing.obj"});
   cases.push_back({{mesh, out, "--emin", "0.2", "--emax", "0.3", "--stats", dir.file("s.txt")}, "--stats"});
 #endif
+  fs::create_directory(dir.file("taken.obj"));
+#ifdef REMESH_CLI_HAS_REMESHER
+  cases.push_back({{mesh, "/proc/out.obj", "--emin", "0.2", "--emax", "0.3"}, "/proc"});
+  cases.push_back({{mesh, out, "--emin", "0.2", "--emax", "0.3", "--dual", "/proc/d.xyz"}, "/proc"});
+#endif
   for (const auto& c : cases) {
     std::string joined;
     for (const auto& a : c.args) joined += a + " ";
@@ -144,6 +154,8 @@ TEST_CASE("bad arguments exit with 2 and one line on stderr", "[cli]") {
     CHECK(r.err.find(c.mentions) != std::string::npos);
   }
   CHECK(!fs::exists(dir.file("out.obj")));
+  for (const auto& entry : fs::directory_iterator(dir.path))
+    CHECK(entry.path().filename().string().find("remesh-probe") == std::string::npos);  // no probe left behind
 }
 
 TEST_CASE("a bad input mesh exits with 3 and one line on stderr", "[cli]") {
