@@ -151,6 +151,24 @@ struct HttpServer::Impl {
     };
   }
 
+  /// Refuses a query parameter the route does not take, as the job parameters of a POST are (422,
+  /// each named): a misspelt `?fromat=ply` got the default OBJ. `access_token` goes with every route.
+  static Handler known_query(std::vector<std::string> known, Handler h) {
+    return [known = std::move(known), h = std::move(h)](const httplib::Request& req, httplib::Response& res) {
+      std::vector<FieldError> errors;
+      for (const auto& [key, value] : req.params) {
+        if (key == "access_token" || std::find(known.begin(), known.end(), key) != known.end()) continue;
+        if (std::any_of(errors.begin(), errors.end(), [&](const FieldError& e) { return e.field == key; })) continue;
+        std::string takes;
+        for (const auto& k : known) takes += (takes.empty() ? "" : ", ") + k;
+        errors.push_back({key.substr(0, 64), "unknown parameter (this route takes " +
+                                                 (takes.empty() ? std::string("none") : takes) + ")"});
+      }
+      if (!errors.empty()) return send_problem(res, 422, "invalid query: see errors", errors);
+      h(req, res);
+    };
+  }
+
   std::string route_label(const httplib::Request& req) const {
     for (const auto& [re, label] : route_labels)
       if (std::regex_match(req.path, re)) return label;
@@ -308,12 +326,16 @@ void HttpServer::Impl::setup() {
       send_problem(res, 500, "internal error");
     }
   });
-  server.Get(jobs_path, guard([this](const auto& req, auto& res) { list_jobs(req, res); }));
-  server.Get(job_path, guard([this](const auto& req, auto& res) { get_job(req, res); }));
-  server.Delete(job_path, guard([this](const auto& req, auto& res) { delete_job(req, res); }));
-  server.Get(job_path + "/events", guard([this](const auto& req, auto& res) { events(req, res); }));
-  server.Get(job_path + "/result", guard([this](const auto& req, auto& res) { result(req, res); }));
-  server.Get(job_path + "/stats", guard([this](const auto& req, auto& res) { stats(req, res); }));
+  server.Get(jobs_path, guard(known_query({"state", "limit", "offset"},
+                                          [this](const auto& req, auto& res) { list_jobs(req, res); })));
+  server.Get(job_path, guard(known_query({}, [this](const auto& req, auto& res) { get_job(req, res); })));
+  server.Delete(job_path, guard(known_query({}, [this](const auto& req, auto& res) { delete_job(req, res); })));
+  server.Get(job_path + "/events",
+             guard(known_query({"lastEventId"}, [this](const auto& req, auto& res) { events(req, res); })));
+  server.Get(job_path + "/result",
+             guard(known_query({"mesh", "format"}, [this](const auto& req, auto& res) { result(req, res); })));
+  server.Get(job_path + "/stats",
+             guard(known_query({"format"}, [this](const auto& req, auto& res) { stats(req, res); })));
   server.Get("/.*", guard([this](const auto& req, auto& res) { static_files(req, res); }));
   // Any other POST, PUT or PATCH: no such route. Routed with a content reader so that a request
   // without a body is answered at once (cpp-httplib 0.11 otherwise waits for a body that has no
