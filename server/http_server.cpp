@@ -90,6 +90,13 @@ void send_problem(httplib::Response& res, int status, const std::string& detail,
   send_problem(res, make_problem(status, detail, errors));
 }
 
+/// Does the request carry a body? Without Content-Length and Transfer-Encoding it has none (RFC
+/// 9112 6.3), and cpp-httplib 0.11's reader would wait for one until the client closed or the
+/// read timed out (30 s).
+bool has_body(const httplib::Request& req) {
+  return req.has_header("Content-Length") || req.has_header("Transfer-Encoding");
+}
+
 std::string range_problem(const httplib::Request& req) {
   return "the Range header '" + req.get_header_value("Range") + "' is malformed or starts past the end of " +
          req.path;
@@ -154,15 +161,17 @@ struct HttpServer::Impl {
   /// Refuses a query parameter the route does not take, as the job parameters of a POST are (422,
   /// each named): a misspelt `?fromat=ply` got the default OBJ. `access_token` goes with every route.
   static Handler known_query(std::vector<std::string> known, Handler h) {
-    return [known = std::move(known), h = std::move(h)](const httplib::Request& req, httplib::Response& res) {
+    std::string takes;
+    for (const auto& k : known) takes += (takes.empty() ? "" : ", ") + k;
+    const std::string message = "unknown parameter (this route takes " + (takes.empty() ? "none" : takes) + ")";
+    return [known = std::move(known), message, h = std::move(h)](const httplib::Request& req,
+                                                                  httplib::Response& res) {
       std::vector<FieldError> errors;
       for (const auto& [key, value] : req.params) {
         if (key == "access_token" || std::find(known.begin(), known.end(), key) != known.end()) continue;
-        if (std::any_of(errors.begin(), errors.end(), [&](const FieldError& e) { return e.field == key; })) continue;
-        std::string takes;
-        for (const auto& k : known) takes += (takes.empty() ? "" : ", ") + k;
-        errors.push_back({key.substr(0, 64), "unknown parameter (this route takes " +
-                                                 (takes.empty() ? std::string("none") : takes) + ")"});
+        const std::string field = key.substr(0, 64);
+        if (std::any_of(errors.begin(), errors.end(), [&](const FieldError& e) { return e.field == field; })) continue;
+        errors.push_back({field, message});
       }
       if (!errors.empty()) return send_problem(res, 422, "invalid query: see errors", errors);
       h(req, res);
@@ -341,7 +350,7 @@ void HttpServer::Impl::setup() {
   // without a body is answered at once (cpp-httplib 0.11 otherwise waits for a body that has no
   // length until its read timeout, 30 s); a body, if any, is read and dropped.
   auto no_route = [](const httplib::Request& req, httplib::Response& res, const httplib::ContentReader& reader) {
-    if (req.has_header("Content-Length") || req.has_header("Transfer-Encoding"))
+    if (has_body(req))
       if (!reader([](const char*, std::size_t) { return true; })) res.set_header("Connection", "close");
     send_problem(res, 404, "no such route: " + req.method + " " + req.path);
   };
@@ -389,12 +398,9 @@ void HttpServer::Impl::post_job(const httplib::Request& req, httplib::Response& 
     return total <= limit + kDrainBytes;  // past this, stop reading and close
   };
   bool ok = true;
-  // A request with neither Content-Length nor Transfer-Encoding has no body (RFC 9112 6.3), and
-  // the reader would wait for one until the client closed or the read timed out (cpp-httplib 0.11:
-  // 'curl -X POST' without a file got its error after 30 s). Nothing to read: the checks below
-  // say what is missing.
-  const bool has_body = req.has_header("Content-Length") || req.has_header("Transfer-Encoding");
-  if (!has_body) {
+  // No body ('curl -X POST' without a file got its error after 30 s): nothing to read, and the
+  // checks below say what is missing.
+  if (!has_body(req)) {
     filename = req.get_param_value("filename");
     part_type = req.get_header_value("Content-Type");
   } else if (req.is_multipart_form_data()) {
