@@ -60,6 +60,18 @@ void jitter(TriMesh& mesh, double amount, std::mt19937& rng) {
   for (auto v : mesh.vertices()) mesh.point(v) += Vec3(d(rng), d(rng), d(rng));
 }
 
+/// `reference` with the vertices within `radius` of a centre moved at random (seeded) by up to one
+/// edge of the hex lattice across (1.5 in x and y) and 0.4 up or down: a crumpled patch.
+TriMesh crumpled(const TriMesh& reference, const std::vector<Vec3>& centres, double radius, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> across(-1.5, 1.5), up(-0.4, 0.4);
+  TriMesh mesh = reference;
+  for (auto v : mesh.vertices())
+    if (std::any_of(centres.begin(), centres.end(), [&](const Vec3& c) { return (reference.point(v) - c).norm() < radius; }))
+      mesh.point(v) += Vec3(across(rng), across(rng), up(rng));
+  return mesh;
+}
+
 /// Sign of the z component of every face normal, +1 or -1 (0 when they disagree or one is flat).
 int facing(const TriMesh& mesh) {
   int sign = 0;
@@ -196,11 +208,7 @@ TEST_CASE("untangle removes the crossings of crumpled patches, folds nothing new
   int tangled = 0, by_moves = 0, by_flattening = 0;
   for (unsigned seed = 1; seed <= 12; ++seed) {
     INFO("seed " << seed);
-    std::mt19937 rng(seed);
-    std::uniform_real_distribution<double> across(-1.5, 1.5), up(-0.4, 0.4);
-    TriMesh mesh = reference;
-    for (auto v : mesh.vertices())
-      if ((reference.point(v) - centre).norm() < 3) mesh.point(v) += Vec3(across(rng), across(rng), up(rng));
+    TriMesh mesh = crumpled(reference, {centre}, 3, seed);
     const std::size_t before = find_self_intersections(mesh, 1).size();
     if (before == 0) continue;  // this draw did not tangle; `tangled` counts those that did
     ++tangled;
@@ -230,6 +238,34 @@ TEST_CASE("untangle removes the crossings of crumpled patches, folds nothing new
   // Both means were needed: some tangles yield to vertex moves, others only to a flattened disk.
   CHECK(by_moves > 0);
   CHECK(by_flattening > 0);
+}
+
+TEST_CASE("untangle flattens tangles side by side in one pass and reports what is left exactly", "[untangle]") {
+  // Three patches of the hex lattice crumpled as above, their centres 5 apart, so that one
+  // flattening pass flattens several disks, each beside faces the ones before it moved. It indexes
+  // the faces once and bounds how far they have drifted since (untangle.cpp, kReindexDrift). (With
+  // centres 4.5 apart, 5 of 60 draws keep a crossing pair, the same with an index rebuilt after
+  // every disk.)
+  const TriMesh reference = test::make_hex_lattice_patch(24, 20, 1.5);
+  const ReferenceSurface surface(reference);
+  const int side = facing(reference);
+  REQUIRE(side != 0);
+  const std::vector<Vec3> centres{Vec3(11, 13, 0), Vec3(16, 13, 0), Vec3(21, 13, 0)};
+  int tangled = 0, flattened = 0;
+  for (unsigned seed = 1; seed <= 12; ++seed) {
+    INFO("seed " << seed);
+    TriMesh mesh = crumpled(reference, centres, 2.5, seed);
+    if (find_self_intersections(mesh, 1).empty()) continue;
+    ++tangled;
+    const UntangleCounts counts = untangle(mesh, surface, 1.2, 1.8, 1);
+    CHECK(counts.left == find_self_intersections(mesh, 1));
+    flattened += counts.flattened > 0;
+    CHECK(counts.left.empty());
+    CHECK(brute_force_pairs(mesh).empty());
+    for (auto v : mesh.vertices()) CHECK(std::abs(mesh.point(v)[2]) <= 1.2);
+  }
+  CHECK(tangled >= 8);
+  CHECK(flattened >= 4);
 }
 
 TEST_CASE("untangle makes no pair of adjacent faces sharper than an edit may", "[untangle]") {
