@@ -185,12 +185,7 @@ class Untangler {
     std::size_t kept = 0;
     for (auto e : edges_of(mesh_, pairs))
       if (try_flip(e)) ++kept;
-    if (kept > 0) {
-      failures_.clear();  // the flipped quads changed their vertices' stars
-      // The flipped faces are no longer where the vertex moves' bound (origins_) says: index
-      // them as they are now, so that drift_ starts again from 0 for the moves that follow.
-      index_faces();
-    }
+    if (kept > 0) failures_.clear();  // the flipped quads changed their vertices' stars
     return kept;
   }
 
@@ -219,11 +214,9 @@ class Untangler {
   /// lowers the crossings of its two faces and takes no edge out of the interval. The quad's
   /// corners do not move, so its faces, before and after, lie in the ball around the corners'
   /// centroid that reaches the farthest corner: the faces that can cross them are those
-  /// faces_near() finds there. A flip moves the two faces' centroids within that ball, which the
-  /// index does not see: drift_ grows by the ball's diameter. It grows by the sum, not the
-  /// largest: a face flipped again in the same round moves again from where the last flip left
-  /// it, so only the sum bounds how far it is from where the index saw it (flip_round indexes
-  /// the faces anew after a round that kept a flip, which sets drift_ back to 0).
+  /// faces_near() finds there. A flip gives its two faces other corners, which the index does not
+  /// see: they join reshaped_, which faces_near() always adds. (The flips used to grow drift_ by
+  /// the ball's diameter, and a round that kept one indexed every face anew: 207 000 on nefertiti.)
   bool try_flip(OpenMesh::EdgeHandle e) {
     if (!flip_is_safe(mesh_, e, 0.0, nullptr, /*turned_ok=*/true)) return false;
     // An edge whose ends a crease joins stays (CreaseGuard::along by the positions alone: in a
@@ -247,7 +240,9 @@ class Untangler {
     if (before == 0 || crossings_of({{{p[3], p[1], p[2]}, {p[2], p[0], p[3]}}}, faces, near) >= before) return false;
     mesh_.flip(e);
     for (const Vec3& x : p) note_move(x, x);
-    drift_ += 2 * radius;
+    for (const FaceHandle f : faces) reshaped_.push_back(f.idx());
+    std::sort(reshaped_.begin(), reshaped_.end());
+    reshaped_.erase(std::unique(reshaped_.begin(), reshaped_.end()), reshaped_.end());
     return true;
   }
 
@@ -280,10 +275,17 @@ class Untangler {
     return n;
   }
 
-  /// The faces that may meet the ball of `radius` around p, from the index of index_faces(): a
-  /// face's centroid has moved by at most drift_ since, and its radius grown by at most 2 drift_.
+  /// The faces that may meet the ball of `radius` around p, ascending: from the index of
+  /// index_faces() (a face's centroid has moved by at most drift_ since, and its radius grown by
+  /// at most 2 drift_, with the same corners), and every face a flip has reshaped since, wherever
+  /// it lies now.
   void faces_near(const Vec3& p, double radius, std::vector<std::uint32_t>& out) const {
     face_index_->within(p, (radius + spheres_.largest + 3 * drift_) * (1 + 1e-9), out);
+    if (reshaped_.empty()) return;
+    const std::size_t found = out.size();
+    out.insert(out.end(), reshaped_.begin(), reshaped_.end());
+    std::inplace_merge(out.begin(), out.begin() + static_cast<std::ptrdiff_t>(found), out.end());
+    out.erase(std::unique(out.begin(), out.end()), out.end());
   }
 
   /// Of the candidate moves that fold nothing (geom::move_is_safe), leave no more of v's edges
@@ -552,6 +554,7 @@ class Untangler {
     face_index_.emplace(spheres_.centres);
     origins_.clear();
     drift_ = 0;
+    reshaped_.clear();
   }
 
   TriMesh& mesh_;
@@ -563,6 +566,8 @@ class Untangler {
   /// The position at index_faces() of each vertex moved since, and the farthest any has moved.
   std::unordered_map<int, Vec3> origins_;
   double drift_ = 0;
+  /// The faces flips have reshaped since index_faces(), ascending (faces_near adds them all).
+  std::vector<std::uint32_t> reshaped_;
   double e_min_, e_max_;
   const CreaseGuard* creases_;  ///< may be null (untangle's `creases`)
   std::vector<int> vertex_mark_, face_mark_;
