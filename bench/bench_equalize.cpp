@@ -3,7 +3,7 @@
 ///
 ///   bench_equalize MESH... [--setup refine|simplify|both|coarsen|all] [--iterations N] [--no-cgal]
 ///                  [--threads T] [--samples N] [--rows-every K] [--no-cleanup] [--keep-creases] [--keep DIR]
-///                  [--spread] [--cgal-matched]
+///                  [--spread] [--cgal-matched] [--repeat N]
 ///
 /// refine:   scale the mesh so its mean edge is 2.25, remesh to [1.2, 1.8] (Table 4.2)
 /// simplify: scale to mean edge 0.75, remesh to [1.2, 1.8] (Table 4.1)
@@ -15,6 +15,7 @@
 /// CGAL: isotropic_remeshing, target (e_min + e_max) / 2, 10 iterations, nothing protected.
 /// --spread: ours also with [1.19, 1.79], [1.21, 1.81], [1.2, 1.82] and [1.18, 1.8] (run_spread).
 /// --cgal-matched: CGAL also with its target scaled so that its mean edge matches ours (run_matched).
+/// --repeat N: N timed runs of each remesher in all, taking turns, and the median time ratio (run_repeats).
 
 #include <malloc.h>
 #include <sys/resource.h>
@@ -52,6 +53,7 @@ struct Options {
   std::size_t samples = 400000;
   std::string keep_dir;
   bool spread = false, cgal_matched = false;
+  int repeat = 1;
 };
 
 constexpr double kEmin = 1.2, kEmax = 1.8;
@@ -60,7 +62,7 @@ constexpr double kEmin = 1.2, kEmax = 1.8;
   std::fprintf(stderr,
                "bench_equalize: %s\nusage: bench_equalize MESH... [--setup refine|simplify|both|coarsen|all] [--iterations N] "
                "[--no-cgal] [--threads T] [--samples N] [--rows-every K] [--no-cleanup] [--keep-creases] [--keep DIR] [--spread] "
-               "[--cgal-matched]\n",
+               "[--cgal-matched] [--repeat N]\n",
                error.c_str());
   std::exit(1);
 }
@@ -90,6 +92,7 @@ Options parse(int argc, char** argv) {
       else if (a == "--keep") o.keep_dir = value();
       else if (a == "--spread") o.spread = true;
       else if (a == "--cgal-matched") o.cgal_matched = true;
+      else if (a == "--repeat") o.repeat = std::max(1, std::stoi(value()));
       else if (!a.empty() && a[0] == '-') usage("unknown option " + a);
       else o.meshes.push_back(a);
     } catch (const std::logic_error&) {
@@ -315,6 +318,44 @@ void run_matched(const std::string& name, const std::string& scaled, const TriMe
               static_cast<double>(ours.n_vertices()) / static_cast<double>(matched.n_vertices()),
               ours_run.seconds / r.seconds);
 }
+
+/// The median of `values` (the mean of the middle two for an even count); 0 when empty.
+double median(std::vector<double> values) {
+  if (values.empty()) return 0;
+  std::sort(values.begin(), values.end());
+  const std::size_t n = values.size();
+  return n % 2 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
+}
+
+/// --repeat N: this machine is shared, and one run's time ratio swings by up to 2x with the load
+/// (cow refined: 1.89-2.64x in five runs in a row). So each remesher runs N times in all (the
+/// first runs above included), ours and CGAL taking turns, and the medians are compared: a burst of
+/// load slows the runs next to each other, one of each, not one side's all.
+void run_repeats(const std::string& name, const std::string& scaled, const ChildResult& ours_first,
+                 const ChildResult& cgal_first, double target, const Options& o, const fs::path& dir) {
+  std::vector<double> ours{ours_first.seconds}, cgal{cgal_first.seconds}, ratios{ours_first.seconds / cgal_first.seconds};
+  const std::string ours_out = (dir / (name + "_ours_repeat.off")).string();
+  const std::string cgal_out = (dir / (name + "_cgal_repeat.off")).string();
+  for (int i = 1; i < o.repeat; ++i) {
+    const ChildResult a = run_ours(scaled, ours_out, kEmin, kEmax, o, false);
+    const ChildResult b = run_cgal(scaled, cgal_out, target);
+    if (!a.ok || !b.ok) {
+      std::printf("repeat %d: FAILED\n", i + 1);
+      return;
+    }
+    ours.push_back(a.seconds), cgal.push_back(b.seconds), ratios.push_back(a.seconds / b.seconds);
+  }
+  auto range = [](const std::vector<double>& v) {
+    char text[64];
+    std::snprintf(text, sizeof text, "%.3f-%.3f", *std::min_element(v.begin(), v.end()),
+                  *std::max_element(v.begin(), v.end()));
+    return std::string(text);
+  };
+  std::printf("repeat %d, taking turns: ours median %.3f s (%s), cgal median %.3f s (%s); ratio of the medians "
+              "%.2fx, median of the %d ratios %.2fx (%s)\n",
+              o.repeat, median(ours), range(ours).c_str(), median(cgal), range(cgal).c_str(), median(ours) / median(cgal),
+              o.repeat, median(ratios), range(ratios).c_str());
+}
 #endif
 
 void run_setup(const std::string& path, const char* setup, double mean_edge, const Options& o, const fs::path& dir) {
@@ -361,6 +402,7 @@ void run_setup(const std::string& path, const char* setup, double mean_edge, con
       if (ours.ok)
         std::printf("ratio ours/cgal: time %.2fx, peak memory %.2fx\n", ours.seconds / cgal.seconds,
                     ours.peak_mib / cgal.peak_mib);
+      if (ours.ok && o.repeat > 1) run_repeats(name, scaled, ours, cgal, target, o, dir);
       if (ours.ok && o.cgal_matched)
         run_matched(name, scaled, input, ours, bench::load_mesh(ours_out), ours_h, cgal_mesh, target, topo_in,
                     crossings_in, o, dir);
