@@ -46,8 +46,9 @@ constexpr double kMaxFlattening = 1.0;
 /// more than this share of the largest face's bounding radius: a disk's crossings are then looked
 /// for in balls up to 1 + 3 kReindexDrift times wider, for the same answers. Measured (Table 4.2
 /// setup): nefertiti refined builds its index of 207 000 faces 3 times instead of 5 (once per
-/// flattened disk before), the untangling 0.58 -> 0.46 s; the same meshes, bit for bit, on 12 runs
-/// (cow, cheese, camelhead, nefertiti, armadillo, bunny_zipper; refined and simplified).
+/// flattened disk before), the untangling 0.58 -> 0.46 s; with flips no longer re-indexing
+/// (reshaped_), twice and 0.38 s. The same meshes, bit for bit, on 12 runs (cow, cheese,
+/// camelhead, nefertiti, armadillo, bunny_zipper; refined and simplified).
 constexpr double kReindexDrift = 1.0;
 
 /// Vertices of the faces of `pairs`, each once, in increasing order.
