@@ -283,7 +283,10 @@ void HttpServer::Impl::setup() {
       case 404: detail = "no such route: " + req.method + " " + req.path; break;
       case 413: detail = "the request body is too large"; break;
       case 400:
-        detail = "malformed request";
+        // cpp-httplib says no more than the status: name what makes a request unreadable.
+        detail = "malformed request: a request line or header that does not parse as HTTP/1.1, a header line "
+                 "longer than the server reads (8 KiB), or a body that does not match its Content-Length, "
+                 "Transfer-Encoding or multipart boundary";
         if (req.get_header_value("Content-Type").find("multipart/form-data") != std::string::npos)
           detail += " (multipart/form-data: nothing may follow the boundary parameter, e.g. no '; charset=')";
         break;
