@@ -181,6 +181,7 @@ json job_to_json(const JobRecord& job, std::string_view prefix, double now) {
                                            {"limit", job.thin_parts->limit},
                                            {"at_irregular_vertices", job.thin_parts->at_irregular}}
                                      : json(nullptr)},
+      {"crossing_pairs", job.crossing_pairs ? json(*job.crossing_pairs) : json(nullptr)},
       {"seconds_by_step", job.seconds_by_step ? step_seconds_to_json(*job.seconds_by_step) : json(nullptr)},
       {"dual", job.dual ? dual_to_json(*job.dual) : json(nullptr)},
       {"error", job.error ? json(*job.error) : json(nullptr)},
@@ -223,6 +224,9 @@ JobRecord job_from_json(const json& j) {
       // Absent in documents written before the count existed: 0 there.
       job.thin_parts->at_irregular = t->value("at_irregular_vertices", std::size_t{0});
     }
+    // Absent in documents written before the field existed.
+    if (const auto c = j.find("crossing_pairs"); c != j.end() && !c->is_null())
+      job.crossing_pairs = c->get<std::size_t>();
     if (const auto t = j.find("seconds_by_step"); t != j.end() && !t->is_null())
       job.seconds_by_step = step_seconds_from_json(*t);
     // Absent in documents written before the field existed.

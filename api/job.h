@@ -50,6 +50,9 @@ struct JobRecord {
   /// Of the result: its edges outside the interval and those in parts of the input too thin for
   /// any edge there to be inside (remesh/thin_parts.h); nullopt until the job succeeded.
   std::optional<ThinParts> thin_parts;
+  /// Of the result: its pairs of faces that cross each other (Result::crossing_pairs); nullopt
+  /// until the job succeeded.
+  std::optional<std::size_t> crossing_pairs;
   /// Of the run that succeeded: where its time went, step by step (Result::phases), and the
   /// remeshing call's own seconds (Result::seconds); nullopt until the job succeeded.
   struct StepSeconds {

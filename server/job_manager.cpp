@@ -274,6 +274,7 @@ void JobManager::run(const std::string& id) {
       std::lock_guard lock(mutex_);
       job->record.outcome = std::string(remesh::api::outcome_name(out.outcome));
       job->record.thin_parts = out.thin;
+      job->record.crossing_pairs = out.crossing_pairs;
       job->record.dual = out.dual;
       job->record.seconds_by_step = remesh::api::JobRecord::StepSeconds{out.phases, out.seconds};
     }

@@ -44,6 +44,7 @@ RunOutput run_job(const remesh::api::JobRecord& job, std::string upload, unsigne
   out.outcome = result.outcome;
   out.iterations_done = result.iterations_done;
   out.thin = result.thin;
+  out.crossing_pairs = result.crossing_pairs;
   out.phases = result.phases;
   out.seconds = result.seconds;
   if (result.outcome == remesh::Outcome::Cancelled) return out;

@@ -4,6 +4,7 @@
 /// serialise the remeshed mesh and its trivalent dual in every download format.
 
 #include <functional>
+#include <optional>
 #include <stop_token>
 #include <string>
 #include <string_view>
@@ -18,6 +19,7 @@ struct RunOutput {
   remesh::Outcome outcome = remesh::Outcome::Completed;
   int iterations_done = 0;
   remesh::ThinParts thin;  ///< Result::thin
+  std::optional<std::size_t> crossing_pairs;  ///< Result::crossing_pairs
   remesh::PhaseSeconds phases;  ///< Result::phases
   double seconds = 0;           ///< Result::seconds
   remesh::DualStats dual;       ///< the dual's, against [e_min, e_max] / sqrt(3) (not when cancelled)

@@ -299,9 +299,11 @@ std::vector<CrossingKey> crossing_keys(const TriMesh& mesh, const std::vector<st
   return keys;
 }
 
-void untangle_and_mend(TriMesh& mesh, const ReferenceSurface& reference, const Params& params,
-                       std::vector<NeighbourCache>& caches, const CreaseGuard* creases, IterationStats& row,
-                       PhaseSeconds& phases) {
+/// Returns the crossing face pairs of the mesh it leaves (find_self_intersections), which it knows
+/// at every exit without another search.
+std::size_t untangle_and_mend(TriMesh& mesh, const ReferenceSurface& reference, const Params& params,
+                              std::vector<NeighbourCache>& caches, const CreaseGuard* creases, IterationStats& row,
+                              PhaseSeconds& phases) {
   // The row describes the mesh before the feature snap, which takes no edge out of the interval.
   const std::size_t outside_before = row.small + row.big;
   for (int round = 1; round <= kUntangleRounds; ++round) {
@@ -312,11 +314,11 @@ void untangle_and_mend(TriMesh& mesh, const ReferenceSurface& reference, const P
     // Its flips and collapses count with the row's own, as the cleanup's do (count_cleanup).
     row.flips += u.flipped;
     row.collapses += u.collapsed;
-    if (u.moved == 0 || round == kUntangleRounds) return;
+    if (u.moved == 0 || round == kUntangleRounds) return u.left.size();
     // Nothing to mend when no more edges are outside than before (the vertex moves and flips
     // never take one out; a collapse may leave a short one, a flattened disk any).
     const IterationStats now = measure(mesh, params.e_min, params.e_max, params.threads);
-    if (now.small + now.big <= outside_before) return;
+    if (now.small + now.big <= outside_before) return u.left.size();
     const std::vector<CrossingKey> left = crossing_keys(mesh, u.left);
     timer.switch_to(phases.cleanup);
     const CleanupCounts c = run_cleanup(mesh, reference, params, caches, creases, /*final=*/true);
@@ -324,10 +326,11 @@ void untangle_and_mend(TriMesh& mesh, const ReferenceSurface& reference, const P
     count_cleanup(row, c);
     // Again only if the cleanup made faces cross that did not before (the pairs it left alone
     // keep their corners; its edits renumber the faces).
-    if (fixes(c) == 0) return;
+    if (fixes(c) == 0) return u.left.size();
     const std::vector<CrossingKey> after = crossing_keys(mesh, find_self_intersections(mesh, params.threads));
-    if (std::includes(left.begin(), left.end(), after.begin(), after.end())) return;
+    if (std::includes(left.begin(), left.end(), after.begin(), after.end())) return after.size();
   }
+  return find_self_intersections(mesh, params.threads).size();  // not reached: the last round returns
 }
 
 /// The statistics of `mesh` with the iteration number and operation counters of `counted`.
@@ -736,7 +739,7 @@ Result equalize(TriMesh& mesh, const Params& requested, const OnIteration& on_it
       timer.stop();
       const std::size_t fixes_before = row.cleanup_fixes;
       row.cleanup_fixes += snapped;
-      untangle_and_mend(mesh, *reference, params, neighbour_caches, guard.get(), row, phases);
+      result.crossing_pairs = untangle_and_mend(mesh, *reference, params, neighbour_caches, guard.get(), row, phases);
       if (row.cleanup_fixes != fixes_before) row = measured_row(mesh, params, row);
     }
     // The outcome of a run that stopped early describes the mesh returned, which this row does: the
@@ -769,6 +772,10 @@ Result equalize(TriMesh& mesh, const Params& requested, const OnIteration& on_it
   mesh.request_face_normals();
   mesh.update_normals();
   result.thin = thin_parts(mesh, *reference, params.e_min, params.e_max, threads);
+  // A run without the untangling (cleanup off, or stopped before it) counts them here; a cancelled
+  // one leaves them unknown.
+  if (!result.crossing_pairs && result.outcome != Outcome::Cancelled)
+    result.crossing_pairs = find_self_intersections(mesh, threads).size();
   result.seconds = seconds_since(start);
   return result;
 }

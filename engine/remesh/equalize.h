@@ -14,6 +14,7 @@
 #include <algorithm>
 #include <cstddef>
 #include <functional>
+#include <optional>
 #include <stop_token>
 #include <string>
 #include <vector>
@@ -104,6 +105,10 @@ struct Result {
   /// The returned mesh's edges outside the interval, and how many of them lie where the input is
   /// too thin for any edge there to be inside (thin_parts.h).
   ThinParts thin;
+  /// The returned mesh's pairs of faces that cross each other (find_self_intersections: faces
+  /// sharing an edge never count, touching ones neither), after the untangling; left where the
+  /// input crosses itself or parts are thinner than the edges. Unknown for a cancelled run.
+  std::optional<std::size_t> crossing_pairs;
 };
 
 /// Estimated face count of the output: area / (sqrt(3)/4 * m^2), m = (e_min + e_max) / 2, e_max at

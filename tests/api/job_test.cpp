@@ -53,6 +53,7 @@ TEST_CASE("job document: fields, links only when succeeded, round trip", "[api][
   CHECK(doc["latest"].is_null());
   CHECK(doc["outcome"].is_null());
   CHECK(doc["thin_parts"].is_null());
+  CHECK(doc["crossing_pairs"].is_null());
   CHECK(doc["seconds_by_step"].is_null());
   CHECK(doc["dual"].is_null());
   CHECK(doc["error"].is_null());
@@ -75,6 +76,7 @@ TEST_CASE("job document: fields, links only when succeeded, round trip", "[api][
   r.iteration = 9;
   r.thin_parts = ThinParts{12, 7, 1.25};
   r.thin_parts->at_irregular = 5;
+  r.crossing_pairs = 36;
   PhaseSeconds phases;
   phases.stellar = 0.5, phases.projection = 0.25, phases.untangle = 0.125;
   r.seconds_by_step = JobRecord::StepSeconds{phases, 1.0};
@@ -103,6 +105,7 @@ TEST_CASE("job document: fields, links only when succeeded, round trip", "[api][
   CHECK(doc["thin_parts"]["in_thin_parts"] == 7);
   CHECK(doc["thin_parts"]["limit"] == 1.25);
   CHECK(doc["thin_parts"]["at_irregular_vertices"] == 5);
+  CHECK(doc["crossing_pairs"] == 36);
   CHECK(doc["timings"]["queued_seconds"] == Approx(1.0));
   CHECK(doc["timings"]["run_seconds"] == Approx(3.0));
   REQUIRE(doc["links"].contains("results"));
@@ -122,6 +125,13 @@ TEST_CASE("job document: fields, links only when succeeded, round trip", "[api][
   CHECK(back.thin_parts->in_thin_parts == 7);
   CHECK(back.thin_parts->limit == 1.25);
   CHECK(back.thin_parts->at_irregular == 5);
+  CHECK(back.crossing_pairs == std::optional<std::size_t>(36));
+  {
+    // A record written before the field existed reads without it.
+    json old = doc;
+    old.erase("crossing_pairs");
+    CHECK_FALSE(job_from_json(old).crossing_pairs);
+  }
   {
     // A record written before the count existed reads with 0.
     json old = doc;

@@ -382,6 +382,8 @@ TEST_CASE("the summary says how many edges outside lie in parts too thin for the
   CHECK(s.out.find("100.000 %") != std::string::npos);
   CHECK(s.out.find("in thin parts") == std::string::npos);
   CHECK(s.out.find("irregular valence") == std::string::npos);
+  // Nor do its faces cross each other; the line says so.
+  CHECK(s.out.find("  crossing faces:       0 pairs\n") != std::string::npos);
 }
 
 TEST_CASE("the summary says where the time went, step by step, adding up to the run's seconds", "[cli]") {

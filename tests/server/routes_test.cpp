@@ -88,6 +88,7 @@ TEST_CASE("remeshd: submit raw and multipart, follow, download, list, delete", "
   CHECK(done["thin_parts"]["outside"] == done["latest"]["small"].get<int>() + done["latest"]["big"].get<int>());
   CHECK(done["thin_parts"]["in_thin_parts"] == 0);
   CHECK(done["thin_parts"]["limit"].get<double>() == Approx(0.4 / std::sqrt(3.0)));
+  CHECK(done["crossing_pairs"] == 0);  // a ball's result does not cross itself
   // The dual of the result: one atom per triangle, one bond per edge, one ring per vertex of the
   // ball (closed: sum of (6 - sides) = 12), its bonds judged against [0.2, 0.35] / sqrt(3).
   const json& dual = done["dual"];

@@ -232,6 +232,7 @@ TEST_CASE("cancelling returns a valid mesh and Outcome::Cancelled", "[equalize]"
     if (s.iteration == 3) source.request_stop();
   }, source.get_token());
   CHECK(r.outcome == Outcome::Cancelled);
+  CHECK_FALSE(r.crossing_pairs);  // unknown: the untangling did not run
   CHECK(r.iterations_done == 3);
   CHECK(seen == 3);
   CHECK(test::check_mesh_valid(mesh) == "");
@@ -242,6 +243,36 @@ TEST_CASE("cancelling returns a valid mesh and Outcome::Cancelled", "[equalize]"
   TriMesh untouched = test::make_icosphere(2);
   CHECK(equalize(untouched, table_4_2(), {}, early.get_token()).outcome == Outcome::Cancelled);
   CHECK(test::check_mesh_valid(untouched) == "");
+}
+
+TEST_CASE("the result counts the faces that cross each other, as a recount of the output does", "[equalize]") {
+  // Two spheres overlapping, given as one mesh of two components: each follows its own surface, so
+  // the result crosses itself along the circle where they meet, as the input does. A torus does not.
+  TriMesh spheres = test::make_icosphere(3);
+  {
+    const TriMesh other = test::make_icosphere(3);
+    std::vector<OpenMesh::VertexHandle> added;
+    for (auto v : other.vertices()) added.push_back(spheres.add_vertex(other.point(v) + Vec3(1.2, 0, 0)));
+    for (auto f : other.faces()) {
+      std::vector<OpenMesh::VertexHandle> corners;
+      for (auto v : other.fv_range(f)) corners.push_back(added[v.idx()]);
+      spheres.add_face(corners);
+    }
+  }
+  REQUIRE(test::check_mesh_valid(spheres) == "");
+  REQUIRE_FALSE(find_self_intersections(spheres, 1).empty());
+  TriMesh torus = test::make_torus(48, 16, 3.0, 1.0);
+  std::size_t counted[2] = {0, 0};
+  int k = 0;
+  for (TriMesh* mesh : {&spheres, &torus}) {
+    test::scale_mean_edge(*mesh, 2.25);
+    const Result r = equalize(*mesh, table_4_2(60));
+    REQUIRE(r.crossing_pairs);
+    CHECK(*r.crossing_pairs == find_self_intersections(*mesh, 1).size());
+    counted[k++] = *r.crossing_pairs;
+  }
+  CHECK(counted[0] > 0);
+  CHECK(counted[1] == 0);
 }
 
 TEST_CASE("convergence stops early unless all iterations are asked for", "[equalize]") {

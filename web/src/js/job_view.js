@@ -215,6 +215,7 @@ export class JobView {
     if (thin && thin.outside > 0)
       text += ` · ${thin.outside} edges outside, ${thin.in_thin_parts} of them where the input is thinner than ${thin.limit.toPrecision(3)}` +
         (thin.at_irregular_vertices !== undefined ? `, ${thin.at_irregular_vertices} at vertices of valence other than 6` : '');
+    if (job.crossing_pairs > 0) text += ` · ${job.crossing_pairs} pairs of faces crossing each other`;
     const secs = this.rows.reduce((s, r) => s + (r.seconds || 0), 0);
     if (secs) text += ` · ${secs.toFixed(1)} s`;
     $('progress-text').textContent = text;
