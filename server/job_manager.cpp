@@ -262,7 +262,8 @@ void JobManager::run(const std::string& id) {
     };
     auto write = [&](const std::string& name, std::string_view bytes) { store_.write_file(id, name, bytes); };
     RunOutput out = run_job(record, std::move(upload), config_.engine_threads, on_iteration, token, write);
-    if (out.outcome == remesh::Outcome::Cancelled) {
+    const remesh::Result& result = out.result;
+    if (result.outcome == remesh::Outcome::Cancelled) {
       {
         std::lock_guard lock(mutex_);
         job->record.outcome = "cancelled";
@@ -272,11 +273,11 @@ void JobManager::run(const std::string& id) {
     }
     {
       std::lock_guard lock(mutex_);
-      job->record.outcome = std::string(remesh::api::outcome_name(out.outcome));
-      job->record.thin_parts = out.thin;
-      job->record.crossing_pairs = out.crossing_pairs;
+      job->record.outcome = std::string(remesh::api::outcome_name(result.outcome));
+      job->record.thin_parts = result.thin;
+      job->record.crossing_pairs = result.crossing_pairs;
       job->record.dual = out.dual;
-      job->record.seconds_by_step = remesh::api::JobRecord::StepSeconds{out.phases, out.seconds};
+      job->record.seconds_by_step = remesh::api::JobRecord::StepSeconds{result.phases, result.seconds};
     }
     finish(JobState::Succeeded);
   } catch (const std::exception& e) {

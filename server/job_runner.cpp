@@ -38,16 +38,9 @@ RunOutput run_job(const remesh::api::JobRecord& job, std::string upload, unsigne
   remesh::TriMesh& mesh = loaded.mesh;
   remesh::Params params = job.params;
   params.threads = threads;
-  remesh::Result result = remesh::equalize(mesh, params, on_iteration, stop);
-
   RunOutput out;
-  out.outcome = result.outcome;
-  out.iterations_done = result.iterations_done;
-  out.thin = result.thin;
-  out.crossing_pairs = result.crossing_pairs;
-  out.phases = result.phases;
-  out.seconds = result.seconds;
-  if (result.outcome == remesh::Outcome::Cancelled) return out;
+  out.result = remesh::equalize(mesh, params, on_iteration, stop);
+  if (out.result.outcome == remesh::Outcome::Cancelled) return out;
 
   collect_garbage(mesh);
   for (const std::string& f : remesh::api::remeshed_formats())
@@ -62,7 +55,7 @@ RunOutput run_job(const remesh::api::JobRecord& job, std::string upload, unsigne
     remesh::relax_bonds(dual, params.e_min, params.e_max, reference, params.threads, stop);
     // A stop asked for meanwhile (DELETE, shutdown) cancels the job, as during the run.
     if (stop.stop_requested()) {
-      out.outcome = remesh::Outcome::Cancelled;
+      out.result.outcome = remesh::Outcome::Cancelled;
       return out;
     }
   }

@@ -4,7 +4,6 @@
 /// serialise the remeshed mesh and its trivalent dual in every download format.
 
 #include <functional>
-#include <optional>
 #include <stop_token>
 #include <string>
 #include <string_view>
@@ -16,13 +15,10 @@
 namespace remeshd {
 
 struct RunOutput {
-  remesh::Outcome outcome = remesh::Outcome::Completed;
-  int iterations_done = 0;
-  remesh::ThinParts thin;  ///< Result::thin
-  std::optional<std::size_t> crossing_pairs;  ///< Result::crossing_pairs
-  remesh::PhaseSeconds phases;  ///< Result::phases
-  double seconds = 0;           ///< Result::seconds
-  remesh::DualStats dual;       ///< the dual's, against [e_min, e_max] / sqrt(3) (not when cancelled)
+  /// The engine's, whole (outcome, thin parts, crossing pairs, seconds by step); its outcome is
+  /// Cancelled also when a stop came during the dual's relaxation.
+  remesh::Result result;
+  remesh::DualStats dual;  ///< the dual's, against [e_min, e_max] / sqrt(3) (not when cancelled)
 };
 
 /// Receives each result file as soon as it is serialised: its name ("remeshed.obj", "dual.glb",

@@ -300,13 +300,13 @@ std::vector<CrossingKey> crossing_keys(const TriMesh& mesh, const std::vector<st
 }
 
 /// Returns the crossing face pairs of the mesh it leaves (find_self_intersections), which it knows
-/// at every exit without another search.
+/// at every exit without another search. The last round returns after its untangling.
 std::size_t untangle_and_mend(TriMesh& mesh, const ReferenceSurface& reference, const Params& params,
                               std::vector<NeighbourCache>& caches, const CreaseGuard* creases, IterationStats& row,
                               PhaseSeconds& phases) {
   // The row describes the mesh before the feature snap, which takes no edge out of the interval.
   const std::size_t outside_before = row.small + row.big;
-  for (int round = 1; round <= kUntangleRounds; ++round) {
+  for (int round = 1;; ++round) {
     PhaseTimer timer(phases.untangle);
     const UntangleCounts u =
         untangle_creases_first(mesh, reference, params.e_min, params.e_max, params.threads, creases);
@@ -330,7 +330,6 @@ std::size_t untangle_and_mend(TriMesh& mesh, const ReferenceSurface& reference, 
     const std::vector<CrossingKey> after = crossing_keys(mesh, find_self_intersections(mesh, params.threads));
     if (std::includes(left.begin(), left.end(), after.begin(), after.end())) return after.size();
   }
-  return find_self_intersections(mesh, params.threads).size();  // not reached: the last round returns
 }
 
 /// The statistics of `mesh` with the iteration number and operation counters of `counted`.

@@ -187,7 +187,7 @@ TEST_CASE("run_job hands each result file to the sink once, and none when cancel
     files[name] = std::string(bytes);
   };
   const RunOutput out = run_job(job, upload, 1, {}, std::stop_token{}, sink);
-  CHECK(out.outcome != remesh::Outcome::Cancelled);
+  CHECK(out.result.outcome != remesh::Outcome::Cancelled);
   std::set<std::string> expected;
   for (const auto& f : remesh::api::remeshed_formats()) expected.insert("remeshed." + f);
   for (const auto& f : remesh::api::dual_formats()) expected.insert("dual." + f);
@@ -208,6 +208,6 @@ TEST_CASE("run_job hands each result file to the sink once, and none when cancel
   std::size_t calls = 0;
   const RunOutput cancelled = run_job(job, upload, 1, {}, stopped.get_token(),
                                       [&](const std::string&, std::string_view) { ++calls; });
-  CHECK(cancelled.outcome == remesh::Outcome::Cancelled);
+  CHECK(cancelled.result.outcome == remesh::Outcome::Cancelled);
   CHECK(calls == 0);
 }
