@@ -7,6 +7,7 @@
 #include <OpenMesh/Core/Mesh/TriMesh_ArrayKernelT.hh>
 
 #include <deque>
+#include <vector>
 
 namespace remesh {
 
@@ -51,6 +52,17 @@ void collect_garbage(Mesh& mesh) {
   std::deque<OpenMesh::HalfedgeHandle*> halfedges;
   std::deque<OpenMesh::FaceHandle*> faces;
   mesh.garbage_collection(vertices, halfedges, faces);
+}
+
+/// collect_garbage(), with each of `faces` (handles of live faces) renumbered as the compaction
+/// renumbers its face.
+template <class Mesh>
+void collect_garbage(Mesh& mesh, std::vector<OpenMesh::FaceHandle>& faces) {
+  std::deque<OpenMesh::VertexHandle*> vertices;
+  std::deque<OpenMesh::HalfedgeHandle*> halfedges;
+  std::deque<OpenMesh::FaceHandle*> update;
+  for (OpenMesh::FaceHandle& f : faces) update.push_back(&f);
+  mesh.garbage_collection(vertices, halfedges, update);
 }
 
 /// Is the boundary loop through halfedge h (or its opposite, whichever is the boundary one) longer

@@ -306,10 +306,13 @@ std::size_t untangle_and_mend(TriMesh& mesh, const ReferenceSurface& reference, 
                               PhaseSeconds& phases) {
   // The row describes the mesh before the feature snap, which takes no edge out of the interval.
   const std::size_t outside_before = row.small + row.big;
+  // The crossing pairs counted after a mend, for the next round's untangling (which would search
+  // for them again).
+  std::optional<std::vector<std::pair<unsigned, unsigned>>> crossing;
   for (int round = 1;; ++round) {
     PhaseTimer timer(phases.untangle);
-    const UntangleCounts u =
-        untangle_creases_first(mesh, reference, params.e_min, params.e_max, params.threads, creases);
+    const UntangleCounts u = untangle_creases_first(mesh, reference, params.e_min, params.e_max, params.threads,
+                                                    creases, std::exchange(crossing, std::nullopt));
     row.cleanup_fixes += u.moved;
     // Its flips and collapses count with the row's own, as the cleanup's do (count_cleanup).
     row.flips += u.flipped;
@@ -327,7 +330,8 @@ std::size_t untangle_and_mend(TriMesh& mesh, const ReferenceSurface& reference, 
     // Again only if the cleanup made faces cross that did not before (the pairs it left alone
     // keep their corners; its edits renumber the faces).
     if (fixes(c) == 0) return u.left.size();
-    const std::vector<CrossingKey> after = crossing_keys(mesh, find_self_intersections(mesh, params.threads));
+    crossing = find_self_intersections(mesh, params.threads);
+    const std::vector<CrossingKey> after = crossing_keys(mesh, *crossing);
     if (std::includes(left.begin(), left.end(), after.begin(), after.end())) return after.size();
   }
 }

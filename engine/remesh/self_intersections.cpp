@@ -4,7 +4,6 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
-#include <numeric>
 #include <vector>
 
 #include "core/parallel.h"
@@ -288,20 +287,25 @@ std::vector<std::pair<unsigned, unsigned>> find_self_intersections(const TriMesh
   // The faces looked at: all, or those within reach of the region (the faces meeting it, and every
   // face that can cross one of them: its sphere meets theirs, so it meets the region grown by
   // their largest diameter).
+  // Deleted faces are passed over (face_spheres leaves them a sphere of radius 0 at the origin).
+  auto live = [&](std::size_t i) {
+    return !mesh.has_face_status() || !mesh.status(OpenMesh::FaceHandle(static_cast<int>(i))).deleted();
+  };
   std::vector<unsigned> faces;
   std::vector<char> in_region;
   if (region) {
     in_region.assign(mesh.n_faces(), 0);
     double largest = 0;
     for (std::size_t i = 0; i < mesh.n_faces(); ++i)
-      if (sphere_meets(*region, spheres.centres[i], spheres.radii[i]))
+      if (live(i) && sphere_meets(*region, spheres.centres[i], spheres.radii[i]))
         in_region[i] = 1, largest = std::max(largest, spheres.radii[i]);
     for (std::size_t i = 0; i < mesh.n_faces(); ++i)
-      if (in_region[i] || sphere_meets(*region, spheres.centres[i], spheres.radii[i], 2 * largest))
+      if (in_region[i] || (live(i) && sphere_meets(*region, spheres.centres[i], spheres.radii[i], 2 * largest)))
         faces.push_back(static_cast<unsigned>(i));
   } else {
-    faces.resize(mesh.n_faces());
-    std::iota(faces.begin(), faces.end(), 0u);
+    faces.reserve(mesh.n_faces());
+    for (std::size_t i = 0; i < mesh.n_faces(); ++i)
+      if (live(i)) faces.push_back(static_cast<unsigned>(i));
   }
   std::vector<std::vector<std::pair<unsigned, unsigned>>> found;
   for_overlapping_spheres(spheres, faces, threads, [&](unsigned i, unsigned j, std::size_t block) {

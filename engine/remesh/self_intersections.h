@@ -39,7 +39,8 @@ inline bool spheres_overlap(const Sphere& a, const Sphere& b) {
   return (a.centre - b.centre).sqrnorm() <= reach * reach;
 }
 
-/// Per face index: its face_sphere() and corners.
+/// Per face index: its face_sphere() and corners (a deleted face: radius 0 at the origin, corners 0;
+/// not counted in `largest`).
 struct FaceSpheres {
   std::vector<Vec3> centres;
   std::vector<double> radii;
@@ -52,8 +53,9 @@ FaceSpheres face_spheres(const TriMesh& mesh);
 bool sphere_meets(const Box& box, const Vec3& centre, double radius, double grow = 0);
 
 /// Every pair (f, g), f < g, of faces of `mesh` that cross (faces_cross), sorted; with `region`,
-/// only the pairs with a face whose bounding sphere meets it. Precondition: no deleted elements.
-/// Parallel; the same answer whatever the thread count.
+/// only the pairs with a face whose bounding sphere meets it. Deleted faces are passed over (the
+/// untangling's collapses leave them until its end). Parallel; the same answer whatever the
+/// thread count.
 std::vector<std::pair<unsigned, unsigned>> find_self_intersections(const TriMesh& mesh, unsigned threads,
                                                                    const Box* region = nullptr);
 

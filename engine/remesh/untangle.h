@@ -32,6 +32,7 @@
 /// Table 4.2 run gives the same mesh (none has crossings left for them).
 
 #include <cstddef>
+#include <optional>
 #include <utility>
 #include <vector>
 
@@ -61,8 +62,11 @@ struct UntangleCounts {
 /// vertex on a crease is collapsed only along it into another, and no flattened disk moves a crease
 /// vertex: the creases stay as the run kept them. (A flip is refused when a crease joins the edge's
 /// ends, CreaseGuard::along(a, b), whatever the angle of its faces: a tangle may crumple them flat.)
+/// `crossing`, when given, are the mesh's crossing face pairs as find_self_intersections() gives
+/// them now (a caller that has just counted them): the search that starts the step is skipped.
 UntangleCounts untangle(TriMesh& mesh, const ReferenceSurface& reference, double e_min, double e_max,
-                        unsigned threads, const CreaseGuard* creases = nullptr);
+                        unsigned threads, const CreaseGuard* creases = nullptr,
+                        std::optional<std::vector<std::pair<unsigned, unsigned>>> crossing = std::nullopt);
 
 /// untangle() with the crease guard, then, for the crossings that leaves, untangle() without it:
 /// a crossing is worse than a crease vertex moved (equalize's last step with Params::keep_creases).
@@ -71,7 +75,9 @@ UntangleCounts untangle(TriMesh& mesh, const ReferenceSurface& reference, double
 /// five intervals; the guard ignored -> the guard alone -> this): cheese simplified 65 -> 116 ->
 /// 72, cow simplified 67 -> 86 -> 67, cow refined (whose input crosses itself) 316 -> 326 -> 317;
 /// fandisk (no crossings) the same meshes throughout.
+/// `crossing` as for untangle().
 UntangleCounts untangle_creases_first(TriMesh& mesh, const ReferenceSurface& reference, double e_min,
-                                      double e_max, unsigned threads, const CreaseGuard* creases);
+                                      double e_max, unsigned threads, const CreaseGuard* creases,
+                                      std::optional<std::vector<std::pair<unsigned, unsigned>>> crossing = std::nullopt);
 
 }  // namespace remesh
