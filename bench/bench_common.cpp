@@ -20,6 +20,31 @@
 
 namespace remesh::bench {
 
+TriMesh subdivide_midpoints(const TriMesh& mesh) {
+  TriMesh out;
+  out.reserve(mesh.n_vertices() + mesh.n_edges(), 2 * mesh.n_edges() + 3 * mesh.n_faces(), 4 * mesh.n_faces());
+  for (auto v : mesh.vertices()) out.add_vertex(mesh.point(v));
+  const std::size_t first_mid = mesh.n_vertices();
+  for (auto e : mesh.edges()) {
+    const auto h = mesh.halfedge_handle(e, 0);
+    out.add_vertex(0.5 * (mesh.point(mesh.from_vertex_handle(h)) + mesh.point(mesh.to_vertex_handle(h))));
+  }
+  for (auto f : mesh.faces()) {
+    OpenMesh::VertexHandle c[3], m[3];
+    int k = 0;
+    for (auto h : mesh.fh_range(f)) {  // halfedge k runs from corner k to corner k + 1
+      c[k] = OpenMesh::VertexHandle(mesh.from_vertex_handle(h).idx());
+      m[k] = OpenMesh::VertexHandle(static_cast<int>(first_mid) + mesh.edge_handle(h).idx());
+      ++k;
+    }
+    out.add_face(c[0], m[0], m[2]);
+    out.add_face(m[0], c[1], m[1]);
+    out.add_face(m[2], m[1], c[2]);
+    out.add_face(m[0], m[1], m[2]);
+  }
+  return out;
+}
+
 TriMesh load_mesh(const std::string& path) {
 #ifdef REMESH_BENCH_HAS_IO
   return read_mesh_file(path).mesh;  // the product's reader: validated and repaired
