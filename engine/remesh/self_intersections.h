@@ -18,9 +18,13 @@ namespace remesh {
 /// Do triangles (a, b, c) and (d, e, f) share a point other than the corners they have in common?
 /// Corners are shared when they are equal points. Two triangles with two corners in common (an edge)
 /// count as not crossing (one would have to fold onto the other, which the edits never do).
-/// Triangles exactly in one plane cross when their insides overlap (a fold within a flat face);
-/// touching (a corner on the other, an edge along it) never counts. Exact up to the rounding of
-/// the orientation tests.
+/// Triangles in one plane cross when their insides overlap (a fold within a flat face); touching
+/// (a corner on the other, an edge along it) never counts. An orientation test whose sign rounding
+/// could have decided counts as 0 (the point on the plane; Shewchuk's error bound), so triangles
+/// that are coplanar but for rounding (a flat face's points, projected onto it) are tested in their
+/// plane. The test looks for an edge of one through the inside of the other, so two triangles that
+/// meet only edge to edge, both ends of their common segment on both boundaries (a sheet and its
+/// exact mirror image), count as touching.
 bool triangles_cross(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d, const Vec3& e, const Vec3& f);
 
 /// triangles_cross for faces f and g of `mesh`; faces with an edge in common never cross.

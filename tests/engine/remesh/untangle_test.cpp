@@ -146,6 +146,44 @@ TEST_CASE("triangles_cross tells crossing triangles from touching and separate o
   CHECK(overlapping > 100);
 }
 
+TEST_CASE("triangles_cross finds no crossing among the pieces of flat faces split at rounded midpoints",
+          "[untangle]") {
+  // Two triangles sharing an edge, in a random plane, each split 1-to-4 at its edges' midpoints:
+  // eight pieces of one flat surface, which touch but never cross. The midpoints are rounded, so
+  // the pieces are coplanar but for rounding, where the orientation tests' signs are noise (the
+  // test took 91 pairs of eight.off split twice for crossings, 296 of nefertiti split once; CGAL's
+  // exact test none). A piece tilted through the face at a small angle still crosses it: the
+  // middle piece with one corner lifted and one lowered by a millionth of the face's size.
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> d(-100.0, 100.0), u(0.0, 1.0);
+  int pairs = 0;
+  for (int trial = 0; trial < 300; ++trial) {
+    INFO("trial " << trial);
+    const Vec3 a(d(rng), d(rng), d(rng)), b(d(rng), d(rng), d(rng)), c(d(rng), d(rng), d(rng));
+    const Vec3 e = a + (0.2 + 0.6 * u(rng)) * (b - a) - (0.3 + 0.7 * u(rng)) * (c - a);  // across ab from c
+    std::vector<std::array<Vec3, 3>> pieces;
+    auto split = [&](const Vec3& p, const Vec3& q, const Vec3& r) {
+      const Vec3 pq = 0.5 * (p + q), qr = 0.5 * (q + r), rp = 0.5 * (r + p);
+      pieces.push_back({p, pq, rp});
+      pieces.push_back({pq, q, qr});
+      pieces.push_back({rp, qr, r});
+      pieces.push_back({pq, qr, rp});
+    };
+    split(a, b, c);
+    split(b, a, e);
+    for (std::size_t i = 0; i < pieces.size(); ++i)
+      for (std::size_t j = i + 1; j < pieces.size(); ++j) {
+        const auto &x = pieces[i], &y = pieces[j];
+        CHECK_FALSE(triangles_cross(x[0], x[1], x[2], y[0], y[1], y[2]));
+        ++pairs;
+      }
+    const auto& middle = pieces[3];
+    const Vec3 lift = 1e-6 * ((b - a) % (c - a)).normalized() * (b - a).norm();
+    CHECK(triangles_cross(a, b, c, middle[0] + lift, middle[1] - lift, middle[2]));
+  }
+  CHECK(pairs == 300 * 28);
+}
+
 TEST_CASE("find_self_intersections finds the pairs a brute-force test finds", "[untangle]") {
   std::mt19937 rng(11);
   struct Case {
