@@ -226,16 +226,14 @@ class Untangler {
 
   /// Records a collapse just made, its from-vertex gone from `gone_at` into `stays` (which stays
   /// where it is): the faces of stays' star, which include every face whose corners it changed,
-  /// are reshaped (faces_near adds them wherever they are), and the ball they span joins the
-  /// moves for refresh(). The faces it deleted are passed over from now on; the mesh keeps them
-  /// until the untangling's end, so that the index and the face numbers stand. No vertex moves:
-  /// the drift does not grow.
+  /// are reshaped (faces_near adds them wherever they are), and both positions join the moves'
+  /// box for refresh() (every such face has stays for a corner, so its sphere meets the box). The
+  /// faces it deleted are passed over from now on; the mesh keeps them until the untangling's end,
+  /// so that the index and the face numbers stand. No vertex moves: the drift does not grow.
   void collapsed(VertexHandle stays, const Vec3& gone_at) {
     collapsed_ = true;
     note_move(gone_at, mesh_.point(stays));
-    for (auto f : mesh_.vf_range(stays)) reshaped_.push_back(f.idx());
-    std::sort(reshaped_.begin(), reshaped_.end());
-    reshaped_.erase(std::unique(reshaped_.begin(), reshaped_.end()), reshaped_.end());
+    reshape(mesh_.vf_range(stays));
     failures_.clear();  // the stars around changed
   }
 
@@ -290,9 +288,7 @@ class Untangler {
     if (before == 0 || crossings_of({{{p[3], p[1], p[2]}, {p[2], p[0], p[3]}}}, faces, near) >= before) return false;
     mesh_.flip(e);
     for (const Vec3& x : p) note_move(x, x);
-    for (const FaceHandle f : faces) reshaped_.push_back(f.idx());
-    std::sort(reshaped_.begin(), reshaped_.end());
-    reshaped_.erase(std::unique(reshaped_.begin(), reshaped_.end()), reshaped_.end());
+    reshape(faces);
     return true;
   }
 
@@ -482,9 +478,7 @@ class Untangler {
     // drift stays as it was.
     auto keep = [&] {
       for (std::size_t i = 0; i < disk.inner.size(); ++i) note_move(start[i], mesh_.point(disk.inner[i]));
-      for (const FaceHandle f : disk.faces) reshaped_.push_back(f.idx());
-      std::sort(reshaped_.begin(), reshaped_.end());
-      reshaped_.erase(std::unique(reshaped_.begin(), reshaped_.end()), reshaped_.end());
+      reshape(disk.faces);
       return true;
     };
     for (std::size_t i = 0; i < disk.inner.size(); ++i) mesh_.point(disk.inner[i]) = projected[i];
@@ -577,6 +571,19 @@ class Untangler {
     if (!moved_) moves_ = Box{}, moved_ = true;
     moves_.add(a);
     moves_.add(b);
+  }
+
+  /// Adds `faces` (FaceHandles) to reshaped_, which stays ascending and without repeats: the new
+  /// ones sorted and merged in, not the whole list sorted again (a flip adds two to up to
+  /// kMaxReshaped).
+  template <class Faces>
+  void reshape(const Faces& faces) {
+    const std::size_t old = reshaped_.size();
+    for (const FaceHandle f : faces) reshaped_.push_back(static_cast<std::uint32_t>(f.idx()));
+    const auto middle = reshaped_.begin() + static_cast<std::ptrdiff_t>(old);
+    std::sort(middle, reshaped_.end());
+    std::inplace_merge(reshaped_.begin(), middle, reshaped_.end());
+    reshaped_.erase(std::unique(reshaped_.begin(), reshaped_.end()), reshaped_.end());
   }
 
   /// Indexes the faces' bounding spheres as the mesh holds them now.
