@@ -581,7 +581,7 @@ Result equalize(TriMesh& mesh, const Params& requested, const OnIteration& on_it
       // Not in the thesis: the look-ahead flips that let 5-7 pairs cancel (regularize.h).
       if (params.cleanup) {
         const RegularizeCounts r = regularize(mesh, params.flip_factor, kRegularizeSweeps, threads, guard.get());
-        counters.flips += r.single + 2 * r.pairs;
+        counters.flips += r.single + r.chain_flips;
       }
     }
     if (stop.stop_requested()) {

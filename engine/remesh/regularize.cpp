@@ -1,7 +1,9 @@
 #include "remesh/regularize.h"
 
+#include <utility>
 #include <vector>
 
+#include "remesh/geometry.h"
 #include "remesh/valence_flips.h"
 
 namespace remesh {
@@ -13,8 +15,9 @@ namespace {
 
 class Regularizer {
  public:
-  Regularizer(TriMesh& mesh, double f, unsigned threads, const CreaseGuard* creases)
-      : mesh_(mesh), info_(mesh, threads), f_(f), marks_(mesh.n_vertices()), creases_(creases) {}
+  Regularizer(TriMesh& mesh, double f, unsigned threads, const CreaseGuard* creases, int depth)
+      : mesh_(mesh), info_(mesh, threads), f_(f), marks_(mesh.n_vertices()), creases_(creases),
+        depth_(depth < 1 ? 1 : depth) {}
 
   std::size_t sweep(RegularizeCounts& counts) {
     std::size_t done = 0;
@@ -28,8 +31,9 @@ class Regularizer {
         flip(e, q);
         touch(q);
         ++counts.single, ++done;
-      } else if (flip_pair(e, q)) {
-        ++counts.pairs, ++done;
+      } else if (cones_kept(q) && chain(e, q, depth_)) {
+        ++counts.chains, ++done;
+        counts.chain_flips += flipped_in_chain_;
       }
     });
     marks_.next_sweep();
@@ -40,38 +44,81 @@ class Regularizer {
   /// Algorithm 4's safety checks and angle rule.
   bool allowed(EdgeHandle e) const { return flip_is_safe(mesh_, e, f_, &info_, false, creases_); }
 
+  /// May a neutral flip of q's edge make a vertex regular? Not a 5 on a cone point nor a 7 on a saddle
+  /// (regularize.h: kConeDeficit).
+  bool cones_kept(const Quad& q) const {
+    auto keeps = [&](VertexHandle v, int delta) {
+      const int valence = info_.valence[v.idx()];
+      if (info_.boundary[v.idx()] || valence + delta != 6) return true;
+      const double deficit = geom::angle_deficit(mesh_, v);
+      return !(valence == 5 && deficit > kConeDeficit) && !(valence == 7 && deficit < -kConeDeficit);
+    };
+    return keeps(q.v0, -1) && keeps(q.v1, -1) && keeps(q.v2, +1) && keeps(q.v3, +1);
+  }
+
   void flip(EdgeHandle e, const Quad& q) {
     mesh_.flip(e);
     info_.flipped(q);
   }
 
-  /// A flip that stands: its quad's vertices and their neighbours are touched. (A pair of flips
-  /// looks one ring further than a single flip: everything it reads lies in the quad's 1-ring.)
+  /// A flip that stands: every vertex within depth_ rings of its quad is touched. (A chain from an
+  /// edge reads the valences and the stars within depth_ rings of the edge's quad: each neutral
+  /// flip of it is at a corner of the last, and so is the flip that ends it.)
   void touch(const Quad& q) {
-    for (auto v : {q.v0, q.v1, q.v2, q.v3}) {
-      marks_.touch(v);
-      for (auto w : mesh_.vv_range(v)) marks_.touch(w);
+    if (in_ring_.size() < mesh_.n_vertices()) in_ring_.resize(mesh_.n_vertices(), 0);
+    ring_.assign({q.v0, q.v1, q.v2, q.v3});
+    for (auto v : ring_) in_ring_[v.idx()] = 1;
+    for (std::size_t begin = 0, r = 0; r < static_cast<std::size_t>(depth_); ++r) {
+      const std::size_t end = ring_.size();
+      for (std::size_t i = begin; i < end; ++i)
+        for (auto w : mesh_.vv_range(ring_[i]))
+          if (!in_ring_[w.idx()]) in_ring_[w.idx()] = 1, ring_.push_back(w);
+      begin = end;
     }
+    for (auto v : ring_) marks_.touch(v), in_ring_[v.idx()] = 0;
   }
 
   /// Flips e (neutral), then the first edge at one of the quad's corners whose flip now lowers the
-  /// deviation; undoes the first flip when there is none.
-  bool flip_pair(EdgeHandle e, const Quad& q) {
+  /// deviation; with `depth` > 1 and none, the first neutral flip there (cones_kept) from which
+  /// such a chain goes on, at most `depth` neutral flips in all. Undoes its flips when none ends so.
+  bool chain(EdgeHandle e, const Quad& q, int depth) {
     flip(e, q);
-    for (VertexHandle corner : {q.v0, q.v1, q.v2, q.v3}) {
+    links_.push_back({e, q});
+    // The candidates first: a flip and its undoing may change a corner's outgoing halfedge, under a
+    // circulator.
+    const std::size_t from = candidates_.size();
+    for (VertexHandle corner : {q.v0, q.v1, q.v2, q.v3})
       for (auto h : mesh_.voh_range(corner)) {
         const EdgeHandle g = mesh_.edge_handle(h);
-        if (g == e || mesh_.is_boundary(g)) continue;
-        const Quad r = quad_of(mesh_, g);
-        if (info_.gain(r) > 0 && allowed(g)) {
-          flip(g, r);
-          touch(q);
-          touch(r);
-          return true;
-        }
+        if (!mesh_.is_boundary(g) && !in_chain(g)) candidates_.push_back(g);
+      }
+    const std::size_t to = candidates_.size();
+    bool done = false;
+    for (std::size_t i = from; i < to && !done; ++i) {
+      const EdgeHandle g = candidates_[i];
+      const Quad r = quad_of(mesh_, g);
+      if (info_.gain(r) > 0 && allowed(g)) {
+        flip(g, r);
+        flipped_in_chain_ = links_.size() + 1;
+        for (const auto& link : links_) touch(link.second);
+        touch(r);
+        done = true;
       }
     }
-    flip(e, quad_of(mesh_, e));  // back: the edge is v2-v3 now; flipping it again restores v0-v1
+    for (std::size_t i = from; depth > 1 && i < to && !done; ++i) {
+      const EdgeHandle g = candidates_[i];
+      const Quad r = quad_of(mesh_, g);
+      if (info_.gain(r) == 0 && allowed(g) && cones_kept(r)) done = chain(g, r, depth - 1);
+    }
+    candidates_.resize(from);
+    links_.pop_back();
+    if (!done) flip(e, quad_of(mesh_, e));  // back: the edge is v2-v3 now; flipping it again restores v0-v1
+    return done;
+  }
+
+  bool in_chain(EdgeHandle g) const {
+    for (const auto& link : links_)
+      if (link.first == g) return true;
     return false;
   }
 
@@ -80,13 +127,20 @@ class Regularizer {
   double f_;
   SweepMarks marks_;
   const CreaseGuard* creases_;
+  int depth_;
+  std::vector<std::pair<EdgeHandle, Quad>> links_;  ///< the chain's flips so far
+  std::vector<EdgeHandle> candidates_;              ///< the chain's edges to try, level after level
+  std::size_t flipped_in_chain_ = 0;                ///< flips of the last chain that stood
+  std::vector<VertexHandle> ring_;                  ///< touch()'s walk (reused buffer)
+  std::vector<char> in_ring_;                       ///< touch()'s membership flags, zero between calls
 };
 
 }  // namespace
 
-RegularizeCounts regularize(TriMesh& mesh, double f, int max_sweeps, unsigned threads, const CreaseGuard* creases) {
+RegularizeCounts regularize(TriMesh& mesh, double f, int max_sweeps, unsigned threads, const CreaseGuard* creases,
+                            int depth) {
   RegularizeCounts counts;
-  Regularizer r(mesh, f, threads, creases);
+  Regularizer r(mesh, f, threads, creases, depth);
   for (int s = 0; s < max_sweeps; ++s)
     if (r.sweep(counts) == 0) break;
   return counts;
