@@ -57,7 +57,7 @@ const std::vector<ParamSpec>& param_specs() {
       {"relax_every", Kind::Integer, false}, {"flip_factor", Kind::Real, false},
       {"run_all_iterations", Kind::Boolean, false}, {"protect_tips", Kind::Boolean, false},
       {"keep_creases", Kind::Boolean, false},       {"relax_dual", Kind::Boolean, false},
-      {"weld", Kind::Boolean, false},
+      {"more_regular", Kind::Boolean, false},       {"weld", Kind::Boolean, false},
   };
   return specs;
 }
@@ -81,6 +81,7 @@ void store(ParsedParams& out, std::string_view name, const Value& v) {
   else if (name == "protect_tips") p.protect_tips = v.boolean;
   else if (name == "keep_creases") p.keep_creases = v.boolean;
   else if (name == "relax_dual") p.relax_dual = v.boolean;
+  else if (name == "more_regular") p.more_regular = v.boolean;
   else if (name == "weld") out.weld = v.boolean;
 }
 
@@ -235,6 +236,7 @@ void to_json(json& j, const Params& p) {
            {"run_all_iterations", p.run_all_iterations},
            {"protect_tips", p.protect_tips},
            {"keep_creases", p.keep_creases},
+           {"more_regular", p.more_regular},
            {"relax_dual", p.relax_dual}};
 }
 

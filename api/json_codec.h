@@ -4,7 +4,7 @@
 /// string map (query string, command line). Shared by remeshd and the `remesh` CLI.
 ///
 /// Parameter names (API, CLI, JSON): emin, emax, iterations, rings, relax_every, flip_factor,
-/// run_all_iterations, protect_tips, keep_creases, relax_dual; `weld` is a read option carried
+/// run_all_iterations, protect_tips, keep_creases, more_regular, relax_dual; `weld` is a read option carried
 /// alongside (ParsedParams::weld).
 
 #include <map>
@@ -36,7 +36,7 @@ void to_json(nlohmann::json& j, const IterationStats& s);
 /// wrong types.
 void from_json(const nlohmann::json& j, IterationStats& s);
 /// {emin, emax, iterations, rings, relax_every, flip_factor, run_all_iterations, protect_tips,
-/// keep_creases, relax_dual}
+/// keep_creases, more_regular, relax_dual}
 void to_json(nlohmann::json& j, const Params& p);
 /// {field, message}
 void to_json(nlohmann::json& j, const FieldError& e);

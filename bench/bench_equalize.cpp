@@ -2,7 +2,7 @@
 /// Reproduces the thesis' Table 4.2 setup on any mesh, and compares with CGAL.
 ///
 ///   bench_equalize MESH... [--setup refine|simplify|both|coarsen|all] [--iterations N] [--no-cgal]
-///                  [--threads T] [--samples N] [--rows-every K] [--no-cleanup] [--keep-creases] [--keep DIR]
+///                  [--threads T] [--samples N] [--rows-every K] [--no-cleanup] [--keep-creases] [--more-regular] [--keep DIR]
 ///                  [--spread] [--cgal-matched] [--repeat N] [--subdivide N]
 ///
 /// refine:   scale the mesh so its mean edge is 2.25, remesh to [1.2, 1.8] (Table 4.2)
@@ -50,7 +50,7 @@ namespace {
 
 struct Options {
   std::vector<std::string> meshes;
-  bool refine = true, simplify = false, coarsen = false, cgal = true, cleanup = true, keep_creases = false;
+  bool refine = true, simplify = false, coarsen = false, cgal = true, cleanup = true, keep_creases = false, more_regular = false;
   int iterations = 100, rows_every = 5;
   unsigned threads = 0;
   std::size_t samples = 400000;
@@ -65,7 +65,7 @@ constexpr double kEmin = 1.2, kEmax = 1.8;
 [[noreturn]] void usage(const std::string& error) {
   std::fprintf(stderr,
                "bench_equalize: %s\nusage: bench_equalize MESH... [--setup refine|simplify|both|coarsen|all] [--iterations N] "
-               "[--no-cgal] [--threads T] [--samples N] [--rows-every K] [--no-cleanup] [--keep-creases] [--keep DIR] [--spread] "
+               "[--no-cgal] [--threads T] [--samples N] [--rows-every K] [--no-cleanup] [--keep-creases] [--more-regular] [--keep DIR] [--spread] "
                "[--cgal-matched] [--repeat N] [--subdivide N]\n",
                error.c_str());
   std::exit(1);
@@ -93,6 +93,7 @@ Options parse(int argc, char** argv) {
       else if (a == "--no-cgal") o.cgal = false;
       else if (a == "--no-cleanup") o.cleanup = false;
       else if (a == "--keep-creases") o.keep_creases = true;
+      else if (a == "--more-regular") o.more_regular = true;
       else if (a == "--keep") o.keep_dir = value();
       else if (a == "--spread") o.spread = true;
       else if (a == "--cgal-matched") o.cgal_matched = true;
@@ -226,6 +227,7 @@ ChildResult run_ours(const std::string& scaled, const std::string& out_file, dou
     p.threads = o.threads;
     p.cleanup = o.cleanup;
     p.keep_creases = o.keep_creases;
+    p.more_regular = o.more_regular;
     IterationStats last;
     const Result r = equalize(mesh, p, [&](const IterationStats& s) {
       if (rows && (s.iteration % o.rows_every == 0 || s.iteration == 1)) print_row(s);
@@ -380,7 +382,8 @@ void run_setup(const std::string& path, const char* setup, double mean_edge, con
                 "iterations%s; input V %zu F %zu (euler %ld, boundary loops %zu, components %zu)\n",
                 path.c_str(), o.subdivide > 0 ? (" subdivided x" + std::to_string(o.subdivide)).c_str() : "", setup, factor,
                 mean_edge, kEmin, kEmax, o.iterations,
-                o.cleanup ? (o.keep_creases ? ", creases kept" : "") : ", no cleanup",
+                o.cleanup ? (std::string(o.keep_creases ? ", creases kept" : "") + (o.more_regular ? ", more regular" : "")).c_str()
+                          : ", no cleanup",
                 mesh.n_vertices(), mesh.n_faces(), topo_in.euler, topo_in.boundary_loops, topo_in.components);
   }
   std::printf("  it  vertices     edges    mean     dev regular%%   small     big  inside%%  splits  collap   flips    "

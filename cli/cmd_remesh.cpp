@@ -33,6 +33,7 @@ const std::vector<OptionSpec> kSpec = {
     {"all-iterations", "", "run all N iterations instead of stopping early (converged or stalled)"},
     {"protect-tips", "", "never move tips (ears, horns, spikes) to mend edges: closer to the input there, more edges outside"},
     {"keep-creases", "", "keep the input's sharp edges (over 75 degrees) exactly, as CAD models need; more edges may stay outside"},
+    {"more-regular", "", "flip further ahead for valence-6 vertices (about 2 points more; hexagons in the dual); tips cut a little more"},
     {"dual", "DUAL_OUT", "also write the trivalent dual of the result, projected onto IN"},
     {"relax-dual", "", "relax the dual's bonds toward the middle of [A, B] / sqrt(3) (atom lattices); needs --dual"},
     {"stats", "FILE", "write the per-iteration statistics to FILE.csv or FILE.json"},
@@ -79,6 +80,7 @@ Job parse_job(const std::vector<std::string>& args) {
   p.run_all_iterations = a.has("all-iterations");
   p.protect_tips = a.has("protect-tips");
   p.keep_creases = a.has("keep-creases");
+  p.more_regular = a.has("more-regular");
   p.relax_dual = a.has("relax-dual");
   job.read.weld = a.has("weld");
   job.quiet = a.has("quiet");

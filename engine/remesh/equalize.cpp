@@ -580,7 +580,8 @@ Result equalize(TriMesh& mesh, const Params& requested, const OnIteration& on_it
       counters.flips = valence_flips(mesh, params.flip_factor, kFlipSweeps, threads, guard.get());
       // Not in the thesis: the look-ahead flips that let 5-7 pairs cancel (regularize.h).
       if (params.cleanup) {
-        const RegularizeCounts r = regularize(mesh, params.flip_factor, kRegularizeSweeps, threads, guard.get());
+        const RegularizeCounts r =
+            regularize(mesh, params.flip_factor, kRegularizeSweeps, threads, guard.get(), params.more_regular ? 2 : 1);
         counters.flips += r.single + r.chain_flips;
       }
     }

@@ -47,6 +47,14 @@ struct Params {
   /// e_min between two creases: a third of the edges left outside are short edges between crease
   /// points, which no collapse may merge), cow refined 99.91 / 1.19 -> 99.79 / 1.27.
   bool keep_creases = false;
+  /// Not in the thesis: the look-ahead flips (regularize.h, with `cleanup`) make chains of up to two
+  /// neutral flips instead of one, for more valence-6 vertices (hexagons in the dual). Measured
+  /// (Table 4.2 setup, means over the five intervals of bench --spread, off -> on): regular vertices
+  /// 1.4-2.1 points more on the 11 shared meshes but cheese (cow 88.1 -> 89.9 %, nefertiti 89.7 ->
+  /// 91.6 %); the largest distance to the input 4 % lower (camelhead) to 37 % higher (at ear tips
+  /// and peaks: bunny 0.62 -> 0.67, mountain 0.15 -> 0.20 % of the bbox diagonal); -2 to +45 % time
+  /// (cow the most).
+  bool more_regular = false;
   /// Not in the thesis, and not used by equalize(): whoever builds the result's trivalent dual
   /// (the CLI's --dual, the service) relaxes its bonds toward the middle of [e_min, e_max] / sqrt(3)
   /// (dual/relax_bonds.h), instead of leaving each dual vertex at its triangle's centroid.

@@ -31,7 +31,7 @@ class Regularizer {
         flip(e, q);
         touch(q);
         ++counts.single, ++done;
-      } else if (cones_kept(q) && chain(e, q, depth_)) {
+      } else if ((depth_ == 1 || cones_kept(q)) && chain(e, q, depth_)) {
         ++counts.chains, ++done;
         counts.chain_flips += flipped_in_chain_;
       }
@@ -44,8 +44,8 @@ class Regularizer {
   /// Algorithm 4's safety checks and angle rule.
   bool allowed(EdgeHandle e) const { return flip_is_safe(mesh_, e, f_, &info_, false, creases_); }
 
-  /// May a neutral flip of q's edge make a vertex regular? Not a 5 on a cone point nor a 7 on a saddle
-  /// (regularize.h: kConeDeficit).
+  /// May a neutral flip of q's edge, in a chain of depth 2 or more, make a vertex regular? Not a 5 on
+  /// a cone point nor a 7 on a saddle (regularize.h: kConeDeficit).
   bool cones_kept(const Quad& q) const {
     auto keeps = [&](VertexHandle v, int delta) {
       const int valence = info_.valence[v.idx()];

@@ -4,21 +4,18 @@
 /// sit in 5-7 pairs (dislocations of the hexagonal lattice); a pair moves by one flip, but that
 /// flip leaves the valence deviation of Algorithm 4 unchanged, so Algorithm 4 never makes it and
 /// pairs that could cancel stay where they are. This step makes a chain of such neutral flips, each
-/// at a corner of the last, at most `depth` of them, when a flip at a corner of the last one then
-/// lowers the deviation: each chain lowers the deviation strictly, so sweeps cannot cycle. Every
-/// flip passes Algorithm 4's angle rule with factor f and its safety checks (flip_is_safe).
-/// A neutral flip never makes regular a valence-5 vertex whose angle deficit exceeds kConeDeficit
-/// (a cone: the tip of an ear, a peak) nor a valence-7 vertex whose deficit is below -kConeDeficit
-/// (a saddle): there the defect belongs to the surface's curvature, and moving it away lets the mesh
-/// cut the tip.
+/// at a corner of the last, at most `depth` of them (one by default), when a flip at a corner of
+/// the last one then lowers the deviation: each chain lowers the deviation strictly, so sweeps
+/// cannot cycle. Every flip passes Algorithm 4's angle rule with factor f and its safety checks
+/// (flip_is_safe). In chains that may be longer than one neutral flip, a neutral flip never makes
+/// regular a valence-5 vertex whose angle deficit exceeds kConeDeficit (a cone: the tip of an ear,
+/// a peak) nor a valence-7 vertex whose deficit is below -kConeDeficit (a saddle): there the defect
+/// belongs to the surface's curvature, and moving it away lets the mesh cut the tip.
 ///
-/// It runs after Algorithm 4 in every iteration (Params::cleanup). Measured in the Table 4.2 setup
-/// (bench_equalize): with one neutral flip, regular vertices 85-87 % -> 88-91 % on spot, bunny,
-/// fandisk, kitten and cow, and the runs converge in fewer iterations. Two neutral flips
-/// (kLookAheadDepth) instead of one: a further 1.5-2.2 points on the 11 shared meshes but cheese
-/// (bench --spread, means of five intervals: cow 88.1 -> 90.1 %, nefertiti 89.7 -> 91.6 %), the
-/// same mean and 99th-percentile distances to the input; the largest distance moves either way at
-/// single tips (bench/README).
+/// It runs after Algorithm 4 in every iteration (Params::cleanup), with depth 2 under
+/// Params::more_regular. Measured in the Table 4.2 setup (bench_equalize): with one neutral flip,
+/// regular vertices 85-87 % -> 88-91 % on spot, bunny, fandisk, kitten and cow, and the runs
+/// converge in fewer iterations. Two: params.h (more_regular).
 
 #include <cstddef>
 
@@ -33,14 +30,12 @@ struct RegularizeCounts {
   std::size_t chain_flips = 0;  ///< the flips of those chains
 };
 
-/// Neutral flips in a chain, at most (regularize's default).
-constexpr int kLookAheadDepth = 2;
 /// The angle deficit (radians) from which a valence-5 vertex counts as a cone point (and, negated,
 /// a valence-7 vertex as a saddle) that neutral flips leave irregular: 0.4, about 38 % of the pi / 3
 /// a whole valence-5 defect carries in a lattice of equilateral triangles. Measured (bench --spread,
-/// Table 4.2 setup, two neutral flips): without it the largest distance to the input grew on kitten
-/// (0.22 -> 0.33 % of the bbox diagonal, mean of five) and mountain (0.15 -> 0.19); with it 0.26 and
-/// 0.18, and at [1.2, 1.8] 0.32 and 0.14.
+/// Table 4.2 setup, two neutral flips, largest distance to the input in % of the bbox diagonal, mean
+/// of five; measured while the sweeps' walk still touched one ring, not two): without it -> with it,
+/// kitten 0.33 -> 0.26 and cheese 3.0 -> 2.8, but bunny 0.62 -> 0.70; one neutral flip: kitten 0.22.
 constexpr double kConeDeficit = 0.4;
 
 /// Sweeps over the interior edges (in index order) while they flip something, at most `max_sweeps`.
@@ -48,6 +43,6 @@ constexpr double kConeDeficit = 0.4;
 /// (1: a neutral flip and one that lowers the deviation).
 /// With `creases`, an edge along a crease is not flipped (flip_is_safe).
 RegularizeCounts regularize(TriMesh& mesh, double f, int max_sweeps = 4, unsigned threads = 1,
-                            const CreaseGuard* creases = nullptr, int depth = kLookAheadDepth);
+                            const CreaseGuard* creases = nullptr, int depth = 1);
 
 }  // namespace remesh

@@ -22,7 +22,7 @@ std::set<std::string> fields_of(const std::vector<FieldError>& errors) {
 
 TEST_CASE("params_from_json: valid documents parse into Params", "[api][params]") {
   ParsedParams p = params_from_json(json::parse(
-      R"({"emin":0.5,"emax":1.5,"iterations":7,"rings":3,"relax_every":2,"flip_factor":0.25,"run_all_iterations":true,"protect_tips":true,"keep_creases":true,"relax_dual":true,"weld":true})"));
+      R"({"emin":0.5,"emax":1.5,"iterations":7,"rings":3,"relax_every":2,"flip_factor":0.25,"run_all_iterations":true,"protect_tips":true,"keep_creases":true,"more_regular":true,"relax_dual":true,"weld":true})"));
   REQUIRE(p.ok());
   CHECK(p.params.e_min == 0.5);
   CHECK(p.params.e_max == 1.5);
@@ -33,6 +33,7 @@ TEST_CASE("params_from_json: valid documents parse into Params", "[api][params]"
   CHECK(p.params.run_all_iterations);
   CHECK(p.params.protect_tips);
   CHECK(p.params.keep_creases);
+  CHECK(p.params.more_regular);
   CHECK(p.params.relax_dual);
   CHECK(p.weld);
 
@@ -42,6 +43,7 @@ TEST_CASE("params_from_json: valid documents parse into Params", "[api][params]"
   CHECK(d.params.rings == Params{}.rings);
   CHECK_FALSE(d.params.protect_tips);
   CHECK_FALSE(d.params.keep_creases);
+  CHECK_FALSE(d.params.more_regular);
   CHECK_FALSE(d.params.relax_dual);
   CHECK_FALSE(d.weld);
 }
@@ -61,6 +63,7 @@ TEST_CASE("params_from_json: every bad field is reported", "[api][params]") {
       {R"({"emin":1,"emax":2,"weld":1})", {"weld"}},
       {R"({"emin":1,"emax":2,"protect_tips":"true"})", {"protect_tips"}},
       {R"({"emin":1,"emax":2,"keep_creases":0})", {"keep_creases"}},
+      {R"({"emin":1,"emax":2,"more_regular":"yes"})", {"more_regular"}},
       {R"({"emin":1,"emax":2,"relax_dual":"on"})", {"relax_dual"}},
       {R"({"emin":1,"emax":2,"flip_factor":null})", {"flip_factor"}},
       {R"({"emin":1,"emax":2,"iterations":99999999999})", {"iterations"}},
@@ -118,10 +121,11 @@ TEST_CASE("Params and summaries map to the documented JSON names", "[api][json]"
   p.e_max = 0.2;
   p.protect_tips = true;
   p.keep_creases = true;
+  p.more_regular = true;
   p.relax_dual = true;
   json j = p;
   for (const char* k : {"emin", "emax", "iterations", "rings", "relax_every", "flip_factor", "run_all_iterations",
-                        "protect_tips", "keep_creases", "relax_dual"})
+                        "protect_tips", "keep_creases", "more_regular", "relax_dual"})
     CHECK(j.contains(k));
   CHECK(j["emin"] == 0.1);
   // Round trip through the parser.
@@ -130,6 +134,7 @@ TEST_CASE("Params and summaries map to the documented JSON names", "[api][json]"
   CHECK(back.params.e_max == 0.2);
   CHECK(back.params.protect_tips);
   CHECK(back.params.keep_creases);
+  CHECK(back.params.more_regular);
 
   MeshSummary s;
   s.vertices = 12;

@@ -276,7 +276,7 @@ TEST_CASE("a short remesh run writes the mesh, the dual and one stats row per it
   write_obj(remesh::test::make_icosphere(2), dir.file("sphere.obj"));
   const std::string out = dir.file("out.obj"), dual = dir.file("dual.obj");
   const ProcessResult r = remesh_cli({dir.file("sphere.obj"), out, "--emin", "0.1", "--emax", "0.15", "--iterations",
-                                      "4", "--all-iterations", "--protect-tips", "--keep-creases", "--stats", dir.file("stats.csv"), "--dual", dual,
+                                      "4", "--all-iterations", "--protect-tips", "--keep-creases", "--more-regular", "--stats", dir.file("stats.csv"), "--dual", dual,
                                       "--threads", "2"});
   INFO(r.err);
   REQUIRE(r.exit_code == 0);

@@ -60,7 +60,7 @@ TEST_CASE("look-ahead flips lower the valence deviation by at least one per flip
     const std::size_t loops = test::count_boundary_loops(mesh);
     // Algorithm 4 has nothing left to flip here.
     REQUIRE(valence_flip_sweep(mesh, 0.5) == 0);
-    const RegularizeCounts counts = regularize(mesh, 0.5, 20);
+    const RegularizeCounts counts = regularize(mesh, 0.5, 20, 1, nullptr, 2);
     chains_seen += counts.chains;
     // A chain is two flips or more; with two neutral flips allowed, some take three.
     CHECK(counts.chain_flips >= 2 * counts.chains);
@@ -73,7 +73,7 @@ TEST_CASE("look-ahead flips lower the valence deviation by at least one per flip
     CHECK(test::count_boundary_loops(mesh) == loops);
     CHECK(mesh.n_vertices() == input.n_vertices());
     // Sweeps stop when one flips nothing: a further pass finds nothing either.
-    const RegularizeCounts more = regularize(mesh, 0.5, 1);
+    const RegularizeCounts more = regularize(mesh, 0.5, 1, 1, nullptr, 2);
     CHECK(more.single + more.chains == 0);
   }
   // The scrambled meshes hold neutral moves that open an improving one, and some need two.
@@ -223,7 +223,7 @@ RegularizeCounts reference_regularize(TriMesh& mesh, double f, int max_sweeps, i
         mesh.flip(e);
         info.flipped(q);
         ++counts.single, ++done;
-      } else if (std::vector<OpenMesh::EdgeHandle> chain; reference_cones_kept(mesh, info, q) &&
+      } else if (std::vector<OpenMesh::EdgeHandle> chain; (depth == 1 || reference_cones_kept(mesh, info, q)) &&
                  reference_chain(mesh, info, e, q, f, depth, chain, flips)) {
         ++counts.chains, ++done;
         counts.chain_flips += flips;

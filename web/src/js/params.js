@@ -4,7 +4,7 @@
 const $ = (id) => document.getElementById(id);
 
 const NUMBERS = ['emin', 'emax', 'iterations', 'rings', 'relax_every', 'flip_factor'];
-const BOOLEANS = ['run_all_iterations', 'protect_tips', 'keep_creases', 'relax_dual', 'weld'];
+const BOOLEANS = ['run_all_iterations', 'protect_tips', 'keep_creases', 'more_regular', 'relax_dual', 'weld'];
 
 /// The params object for POST /jobs. Empty fields are left out (the server applies its defaults,
 /// and reports a missing emin/emax itself); text the browser cannot parse as a number is sent
