@@ -52,33 +52,36 @@ TEST_CASE("look-ahead flips lower the valence deviation by at least one per flip
                             scrambled(test::make_icosphere(4), 2, 800),
                             scrambled(test::make_double_torus(1.0, 3), 3, 400),
                             scrambled(test::make_open_grid(24, 24, 1.0), 4, 500)};
-  std::size_t chains_seen = 0, long_chains = 0;
-  for (const TriMesh& input : inputs) {
-    TriMesh mesh = input;
-    const long before = total_deviation(mesh);
-    const long euler = test::euler_characteristic(mesh);
-    const std::size_t loops = test::count_boundary_loops(mesh);
-    // Algorithm 4 has nothing left to flip here.
-    REQUIRE(valence_flip_sweep(mesh, 0.5) == 0);
-    const RegularizeCounts counts = regularize(mesh, 0.5, 20, 1, nullptr, 2);
-    chains_seen += counts.chains;
-    // A chain is two flips or more; with two neutral flips allowed, some take three.
-    CHECK(counts.chain_flips >= 2 * counts.chains);
-    CHECK(counts.chain_flips <= 3 * counts.chains);
-    long_chains += counts.chain_flips - 2 * counts.chains;
-    const long after = total_deviation(mesh);
-    CHECK(before - after >= static_cast<long>(counts.single + counts.chains));
-    CHECK(test::check_mesh_valid(mesh) == "");
-    CHECK(test::euler_characteristic(mesh) == euler);
-    CHECK(test::count_boundary_loops(mesh) == loops);
-    CHECK(mesh.n_vertices() == input.n_vertices());
-    // Sweeps stop when one flips nothing: a further pass finds nothing either.
-    const RegularizeCounts more = regularize(mesh, 0.5, 1, 1, nullptr, 2);
-    CHECK(more.single + more.chains == 0);
+  for (int depth : {1, 2}) {
+    INFO("depth " << depth);
+    std::size_t chains_seen = 0, long_chains = 0;
+    for (const TriMesh& input : inputs) {
+      TriMesh mesh = input;
+      const long before = total_deviation(mesh);
+      const long euler = test::euler_characteristic(mesh);
+      const std::size_t loops = test::count_boundary_loops(mesh);
+      // Algorithm 4 has nothing left to flip here.
+      REQUIRE(valence_flip_sweep(mesh, 0.5) == 0);
+      const RegularizeCounts counts = regularize(mesh, 0.5, 20, 1, nullptr, depth);
+      chains_seen += counts.chains;
+      // A chain is `depth` + 1 flips at most: neutral ones, then the one that lowers the deviation.
+      CHECK(counts.chain_flips >= 2 * counts.chains);
+      CHECK(counts.chain_flips <= static_cast<std::size_t>(depth + 1) * counts.chains);
+      long_chains += counts.chain_flips - 2 * counts.chains;
+      const long after = total_deviation(mesh);
+      CHECK(before - after >= static_cast<long>(counts.single + counts.chains));
+      CHECK(test::check_mesh_valid(mesh) == "");
+      CHECK(test::euler_characteristic(mesh) == euler);
+      CHECK(test::count_boundary_loops(mesh) == loops);
+      CHECK(mesh.n_vertices() == input.n_vertices());
+      // Sweeps stop when one flips nothing: a further pass finds nothing either.
+      const RegularizeCounts more = regularize(mesh, 0.5, 1, 1, nullptr, depth);
+      CHECK(more.single + more.chains == 0);
+    }
+    // The scrambled meshes hold neutral moves that open an improving one, and some need two.
+    CHECK(chains_seen > 0);
+    CHECK((depth == 1 ? long_chains == 0 : long_chains > 0));
   }
-  // The scrambled meshes hold neutral moves that open an improving one, and some need two.
-  CHECK(chains_seen > 0);
-  CHECK(long_chains > 0);
 }
 
 namespace {
