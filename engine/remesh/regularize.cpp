@@ -44,17 +44,8 @@ class Regularizer {
   /// Algorithm 4's safety checks and angle rule.
   bool allowed(EdgeHandle e) const { return flip_is_safe(mesh_, e, f_, &info_, false, creases_); }
 
-  /// May a neutral flip of q's edge, in a chain of depth 2 or more, make a vertex regular? Not a 5 on
-  /// a cone point nor a 7 on a saddle (regularize.h: kConeDeficit).
-  bool cones_kept(const Quad& q) const {
-    auto keeps = [&](VertexHandle v, int delta) {
-      const int valence = info_.valence[v.idx()];
-      if (info_.boundary[v.idx()] || valence + delta != 6) return true;
-      const double deficit = geom::angle_deficit(mesh_, v);
-      return !(valence == 5 && deficit > kConeDeficit) && !(valence == 7 && deficit < -kConeDeficit);
-    };
-    return keeps(q.v0, -1) && keeps(q.v1, -1) && keeps(q.v2, +1) && keeps(q.v3, +1);
-  }
+  /// The cone rule, for neutral flips in chains of depth 2 or more.
+  bool cones_kept(const Quad& q) const { return remesh::cones_kept(mesh_, info_, q); }
 
   void flip(EdgeHandle e, const Quad& q) {
     mesh_.flip(e);
@@ -136,6 +127,16 @@ class Regularizer {
 };
 
 }  // namespace
+
+bool cones_kept(const TriMesh& mesh, const VertexInfo& info, const Quad& q) {
+  auto keeps = [&](VertexHandle v, int delta) {
+    const int valence = info.valence[v.idx()];
+    if (info.boundary[v.idx()] || valence + delta != 6) return true;
+    const double deficit = geom::angle_deficit(mesh, v);
+    return !(valence == 5 && deficit > kConeDeficit) && !(valence == 7 && deficit < -kConeDeficit);
+  };
+  return keeps(q.v0, -1) && keeps(q.v1, -1) && keeps(q.v2, +1) && keeps(q.v3, +1);
+}
 
 RegularizeCounts regularize(TriMesh& mesh, double f, int max_sweeps, unsigned threads, const CreaseGuard* creases,
                             int depth) {

@@ -21,6 +21,7 @@
 
 #include "core/mesh.h"
 #include "remesh/crease_lines.h"
+#include "remesh/valence_flips.h"
 
 namespace remesh {
 
@@ -37,6 +38,12 @@ struct RegularizeCounts {
 /// of five; measured while the sweeps' walk still touched one ring, not two): without it -> with it,
 /// kitten 0.33 -> 0.26 and cheese 3.0 -> 2.8, but bunny 0.62 -> 0.70; one neutral flip: kitten 0.22.
 constexpr double kConeDeficit = 0.4;
+
+/// The cone rule: may a neutral flip of q's interior edge (valences from `info`, current for `mesh`)
+/// give its four vertices their new valences? False when it would make regular a valence-5 vertex
+/// whose angle deficit exceeds kConeDeficit, or a valence-7 vertex whose deficit is below
+/// -kConeDeficit.
+bool cones_kept(const TriMesh& mesh, const VertexInfo& info, const Quad& q);
 
 /// Sweeps over the interior edges (in index order) while they flip something, at most `max_sweeps`.
 /// `threads` count the valences; the sweeps are serial. `depth`: neutral flips in a chain, at most

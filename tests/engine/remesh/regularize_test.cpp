@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdlib>
 #include <initializer_list>
 #include <random>
@@ -254,5 +255,64 @@ TEST_CASE("look-ahead flips over the edges around touched vertices make exactly 
         [&](TriMesh& m, int sweeps) { return counted(regularize(m, 0.5, sweeps, 1, nullptr, depth)); },
         [&](TriMesh& m, int sweeps) { return counted(reference_regularize(m, 0.5, sweeps, depth)); });
     CHECK(walked.chains > 0);
+  }
+}
+
+namespace {
+
+/// A fan of `n` triangles around a centre vertex at height `lift`, its rim on the unit circle with
+/// the rim vertex k at height `rim(k)`, and one more triangle across the rim edge (rim 0, rim 1) to
+/// an outer vertex. Returns the mesh and the quad of the edge named by `edge`: the rim edge (rim 0,
+/// rim 1), whose flip gives the centre one more edge, or the spoke (centre, rim 1), whose flip
+/// takes one from it.
+enum class FanEdge { Rim, Spoke };
+std::pair<TriMesh, Quad> fan(int n, double lift, double (*rim)(int), FanEdge edge) {
+  TriMesh m;
+  const auto c = m.add_vertex(Vec3(0, 0, lift));
+  std::vector<OpenMesh::VertexHandle> ring;
+  for (int k = 0; k < n; ++k) {
+    const double a = 2 * M_PI * k / n;
+    ring.push_back(m.add_vertex(Vec3(std::cos(a), std::sin(a), rim(k))));
+  }
+  for (int k = 0; k < n; ++k) m.add_face(c, ring[k], ring[(k + 1) % n]);
+  const double a = M_PI / n;  // beyond the middle of the rim edge (rim 0, rim 1)
+  const auto outer = m.add_vertex(Vec3(2 * std::cos(a), 2 * std::sin(a), 0));
+  m.add_face(ring[1], ring[0], outer);
+  OpenMesh::EdgeHandle e;
+  const auto [from, to] = edge == FanEdge::Rim ? std::pair{ring[0], ring[1]} : std::pair{c, ring[1]};
+  for (auto h : m.voh_range(from))
+    if (m.to_vertex_handle(h) == to) e = m.edge_handle(h);
+  const Quad q = quad_of(m, e);
+  return {std::move(m), q};
+}
+
+double flat(int) { return 0; }
+double saddle(int k) { return k % 2 ? 0.6 : -0.6; }
+
+}  // namespace
+
+TEST_CASE("the cone rule keeps a 5 on a cone point and a 7 on a saddle irregular, not on flat ground", "[steps]") {
+  // A valence-5 centre, whose rim-edge flip makes it regular: refused when the centre is a cone's
+  // apex (deficit over kConeDeficit), allowed when the fan is flat.
+  for (double lift : {0.0, 0.3, 1.5}) {
+    auto [m, q] = fan(5, lift, flat, FanEdge::Rim);
+    const VertexInfo info(m);
+    REQUIRE(info.valence[0] == 5);
+    REQUIRE((q.v2.idx() == 0 || q.v3.idx() == 0));  // the centre gains the edge
+    const double deficit = geom::angle_deficit(m, m.vertex_handle(0));
+    INFO("lift " << lift << ", deficit " << deficit);
+    CHECK(cones_kept(m, info, q) == !(deficit > kConeDeficit));
+    if (lift == 0.0) CHECK(cones_kept(m, info, q));
+    if (lift == 1.5) CHECK_FALSE(cones_kept(m, info, q));
+  }
+  // A valence-7 centre, whose spoke flip makes it regular: refused on a saddle, allowed when flat.
+  for (bool bent : {false, true}) {
+    auto [m, q] = fan(7, 0, bent ? saddle : flat, FanEdge::Spoke);
+    const VertexInfo info(m);
+    REQUIRE(info.valence[0] == 7);
+    REQUIRE((q.v0.idx() == 0 || q.v1.idx() == 0));  // the centre loses the edge
+    INFO("deficit " << geom::angle_deficit(m, m.vertex_handle(0)));
+    CHECK(geom::angle_deficit(m, m.vertex_handle(0)) < (bent ? -kConeDeficit : 1e-9));
+    CHECK(cones_kept(m, info, q) == !bent);
   }
 }
