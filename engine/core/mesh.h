@@ -46,16 +46,7 @@ unsigned vertex_valence(const Mesh& mesh, OpenMesh::VertexHandle v) {
 /// overload that updates handles is a template in OpenMesh's headers: called here with containers
 /// of another type than the library's own instantiation, it is compiled into this project, with
 /// NDEBUG. The same compaction, element for element.
-template <class Mesh>
-void collect_garbage(Mesh& mesh) {
-  std::deque<OpenMesh::VertexHandle*> vertices;
-  std::deque<OpenMesh::HalfedgeHandle*> halfedges;
-  std::deque<OpenMesh::FaceHandle*> faces;
-  mesh.garbage_collection(vertices, halfedges, faces);
-}
-
-/// collect_garbage(), with each of `faces` (handles of live faces) renumbered as the compaction
-/// renumbers its face.
+/// With `faces` (handles of live faces), each is renumbered as the compaction renumbers its face.
 template <class Mesh>
 void collect_garbage(Mesh& mesh, std::vector<OpenMesh::FaceHandle>& faces) {
   std::deque<OpenMesh::VertexHandle*> vertices;
@@ -63,6 +54,11 @@ void collect_garbage(Mesh& mesh, std::vector<OpenMesh::FaceHandle>& faces) {
   std::deque<OpenMesh::FaceHandle*> update;
   for (OpenMesh::FaceHandle& f : faces) update.push_back(&f);
   mesh.garbage_collection(vertices, halfedges, update);
+}
+template <class Mesh>
+void collect_garbage(Mesh& mesh) {
+  std::vector<OpenMesh::FaceHandle> none;
+  collect_garbage(mesh, none);
 }
 
 /// Is the boundary loop through halfedge h (or its opposite, whichever is the boundary one) longer

@@ -31,7 +31,7 @@ class Regularizer {
         flip(e, q);
         touch(q);
         ++counts.single, ++done;
-      } else if ((depth_ == 1 || cones_kept(q)) && chain(e, q, depth_)) {
+      } else if ((depth_ == 1 || cones_kept(mesh_, info_, q)) && chain(e, q, depth_)) {
         ++counts.chains, ++done;
         counts.chain_flips += flipped_in_chain_;
       }
@@ -43,9 +43,6 @@ class Regularizer {
  private:
   /// Algorithm 4's safety checks and angle rule.
   bool allowed(EdgeHandle e) const { return flip_is_safe(mesh_, e, f_, &info_, false, creases_); }
-
-  /// The cone rule, for neutral flips in chains of depth 2 or more.
-  bool cones_kept(const Quad& q) const { return remesh::cones_kept(mesh_, info_, q); }
 
   void flip(EdgeHandle e, const Quad& q) {
     mesh_.flip(e);
@@ -99,7 +96,7 @@ class Regularizer {
     for (std::size_t i = from; depth > 1 && i < to && !done; ++i) {
       const EdgeHandle g = candidates_[i];
       const Quad r = quad_of(mesh_, g);
-      if (info_.gain(r) == 0 && allowed(g) && cones_kept(r)) done = chain(g, r, depth - 1);
+      if (info_.gain(r) == 0 && allowed(g) && cones_kept(mesh_, info_, r)) done = chain(g, r, depth - 1);
     }
     candidates_.resize(from);
     links_.pop_back();

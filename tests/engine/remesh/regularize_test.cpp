@@ -160,20 +160,8 @@ TEST_CASE("sweeps that visit only the edges around touched vertices flip exactly
 namespace {
 
 /// The look-ahead flips as regularize.h states them, with full sweeps over every edge: the
-/// reference for the sweeps that visit only the edges around touched vertices.
-/// May a neutral flip of q's edge make its vertices' valences what it makes them (regularize.h's
-/// rule: a 5 on a cone point and a 7 on a saddle stay)?
-bool reference_cones_kept(const TriMesh& mesh, const VertexInfo& info, const Quad& q) {
-  const std::pair<OpenMesh::VertexHandle, int> changes[] = {{q.v0, -1}, {q.v1, -1}, {q.v2, +1}, {q.v3, +1}};
-  for (const auto& [v, delta] : changes) {
-    const int valence = info.valence[v.idx()];
-    if (mesh.is_boundary(v) || valence + delta != 6) continue;
-    const double deficit = geom::angle_deficit(mesh, v);
-    if ((valence == 5 && deficit > kConeDeficit) || (valence == 7 && deficit < -kConeDeficit)) return false;
-  }
-  return true;
-}
-
+/// reference for the sweeps that visit only the edges around touched vertices. (The cone rule is
+/// the engine's cones_kept, tested on its own below.)
 /// Flips e (neutral), then looks for an improving flip at the quad's corners, else (depth > 1) for
 /// a neutral one there to go on from; `chain` holds the edges flipped so far. Undoes on failure.
 bool reference_chain(TriMesh& mesh, VertexInfo& info, OpenMesh::EdgeHandle e, const Quad& q, double f, int depth,
@@ -200,7 +188,7 @@ bool reference_chain(TriMesh& mesh, VertexInfo& info, OpenMesh::EdgeHandle e, co
   }
   for (std::size_t i = 0; depth > 1 && !done && i < around.size(); ++i) {
     const Quad r = quad_of(mesh, around[i]);
-    if (info.gain(r) == 0 && flip_is_safe(mesh, around[i], f) && reference_cones_kept(mesh, info, r))
+    if (info.gain(r) == 0 && flip_is_safe(mesh, around[i], f) && cones_kept(mesh, info, r))
       done = reference_chain(mesh, info, around[i], r, f, depth - 1, chain, flips);
   }
   chain.pop_back();
@@ -227,7 +215,7 @@ RegularizeCounts reference_regularize(TriMesh& mesh, double f, int max_sweeps, i
         mesh.flip(e);
         info.flipped(q);
         ++counts.single, ++done;
-      } else if (std::vector<OpenMesh::EdgeHandle> chain; (depth == 1 || reference_cones_kept(mesh, info, q)) &&
+      } else if (std::vector<OpenMesh::EdgeHandle> chain; (depth == 1 || cones_kept(mesh, info, q)) &&
                  reference_chain(mesh, info, e, q, f, depth, chain, flips)) {
         ++counts.chains, ++done;
         counts.chain_flips += flips;
