@@ -113,8 +113,8 @@ constexpr double kCleanupFrom = 0.97;
 
 /// Iterations of the interval cleanup after which the filter and projection (Alg. 5 and 6) may no
 /// longer take an edge out of the interval: a vertex whose move does goes half way back, up to
-/// three times, then all the way (undo_interval_breaks, fold_guard.h). Until then they run as the
-/// thesis has them. In a run that stalls, they took ~540 edges out of the interval in every
+/// three times, then all the way (undo_interval_breaks, fold_guard.h). Until then only the fold
+/// guard holds them back, as in every iteration. In a run that stalls, they took ~540 edges out of the interval in every
 /// iteration (cow refinement, iterations 15-31: 5-30 edges outside after the stellar operations
 /// and flips, ~550 after the filter and projection), which the cleanup then mended again; the
 /// edges it could not mend wandered, and so did the tips it cut. Measured (Table 4.2 setup, the
@@ -590,7 +590,8 @@ Result equalize(TriMesh& mesh, const Params& requested, const OnIteration& on_it
       break;
     }
 
-    // Algorithm 5 then 6: filter and projection, guarded against folds as one move.
+    // Algorithm 5 then 6: filter and projection, guarded against folds as one move (not in the
+    // thesis: fold_guard.h).
     PhaseTimer move_timer(phases.filter);
     const std::vector<Vec3> before = snapshot_points(mesh);
     // Not in the thesis: until the cleanup starts (and in the first half of the iterations, where

@@ -37,7 +37,10 @@ struct IterationStats {
   double inside_fraction = 0;  ///< fraction of edges inside [e_min, e_max], 0..1
   std::size_t splits = 0, collapses = 0, flips = 0;
   double seconds = 0;                  ///< wall time of this iteration
-  double max_projection_distance = 0;  ///< largest distance a vertex moved in the projection
+  /// largest distance a vertex moved in this iteration's projection (Algorithm 6), measured before
+  /// the fold guard puts some vertices back (fold_guard.h); the projection of the points the
+  /// stellar operations placed is not counted
+  double max_projection_distance = 0;
   /// Local fixes made by the interval cleanup (Params::cleanup) in this iteration; they are also
   /// counted in splits, collapses and flips. Non-zero once the mesh is nearly inside the interval
   /// (and on open meshes, near the boundary, in every iteration).

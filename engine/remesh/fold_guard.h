@@ -1,8 +1,10 @@
 #pragma once
 /// \file fold_guard.h
-/// The safety net of the vertex-moving phases (filter, projection): after they ran, any triangle
-/// that folded over (its normal turned by more than 90 degrees) or became degenerate gets its
-/// vertices put back where they were before the phases, repeatedly until no such triangle is left.
+/// Not in the thesis: the safety net of the vertex-moving phases (filter, projection): after they
+/// ran, any triangle that folded over (its normal turned by more than 90 degrees), folded onto a
+/// neighbour (geom::adjacent_ok) or became degenerate (a smallest angle under geom::kMinAngle it did
+/// not have before) gets its vertices put back where they were before the phases, repeatedly until
+/// no such triangle is left. A vertex put back loses both moves, the filter's and the projection's.
 /// Since the positions before the phases were valid, this always terminates with a valid mesh.
 
 #include <cstddef>

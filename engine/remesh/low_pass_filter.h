@@ -20,8 +20,9 @@ namespace remesh {
 /// deficits far below it.
 constexpr double kCornerDeficit = 1.0;
 
-/// Is v the apex of a sharp cone (angle deficit above kCornerDeficit)? Such vertices stay where
-/// they are in the filter, like boundary vertices: moving a tip sideways and projecting it back
+/// Is v a corner: the apex of a sharp cone, or a saddle as sharp (|angle deficit| above
+/// kCornerDeficit)? Not in the thesis: such vertices stay where they are in the filter, like
+/// boundary vertices: moving a tip sideways and projecting it back
 /// always lands lower on the cone, and over many iterations the tip wears away (the cow's horns
 /// lost 4 edge lengths: Hausdorff 4.8 % of the bbox diagonal against CGAL's 0.9 %).
 bool is_corner(const TriMesh& mesh, OpenMesh::VertexHandle v);

@@ -2,9 +2,10 @@
 /// \file projection.h
 /// Algorithm 6: move every vertex to the closest point of the reference surface (the triangles
 /// incident to its 30 nearest reference vertices, found with the kd-tree of ReferenceSurface).
-/// Boundary vertices go to the closest point of the reference's boundary curves, so boundaries stay
-/// boundaries. Where two sheets are close, the candidate whose normal agrees with the vertex normal
-/// wins. Parallel over vertices; each vertex's result depends only on the mesh before the step.
+/// Not in the thesis: boundary vertices go to the closest point of the reference's boundary curves
+/// (the boundary edges at their 30 nearest reference vertices), so boundaries stay boundaries.
+/// Where two sheets are close, the candidate whose normal agrees with the vertex normal wins
+/// (ALGORITHM.md: prefer it). Parallel over vertices; each vertex's result depends only on the mesh before the step.
 
 #include <vector>
 

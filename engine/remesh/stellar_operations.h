@@ -27,8 +27,9 @@ namespace remesh {
 /// at the (n+1)-th vertex: a few steps for a small n, whatever the mesh's size.
 bool component_larger_than(const TriMesh& mesh, OpenMesh::VertexHandle v, std::size_t n);
 
-/// Splits edge e at the point of eq. 3.1 (target edge length `target`). Returns the new vertex, or
-/// an invalid handle when every candidate point would create a degenerate triangle. With
+/// Splits edge e at the point of eq. 3.1 (target edge length `target`). Not in the thesis: where
+/// that point would make a triangle with an angle under geom::kMinAngle, at the edge's midpoint
+/// instead. Returns the new vertex, or an invalid handle when the midpoint would too. With
 /// `creases`, the point of an edge along a crease is put on the crease (crease_lines.h).
 OpenMesh::VertexHandle split_edge(TriMesh& mesh, OpenMesh::EdgeHandle e, double target,
                                   const CreaseGuard* creases = nullptr);
@@ -94,7 +95,7 @@ OpenMesh::VertexHandle apply_collapse(TriMesh& mesh, const CollapsePlan& plan);
 /// bound refuses 99 % of the collapses of short edges once the mesh is near the target (a short edge
 /// between ordinary ones has far neighbours at about 1.4 m_i from the merged vertex), the mesh stays
 /// 7 % too dense and ends at 95.9 % inside / 80.7 % regular; without any bound it ends at 99.7 % /
-/// 88.3 % (the thesis: 99.65 % / 89.6 %). 2 (m_i - sigma) keeps a bound with a reason: an edge up to
+/// 88.3 % (the thesis, on its Fertility model: 99.65 % / 89.6 %). 2 (m_i - sigma) keeps a bound with a reason: an edge up to
 /// that long splits into two halves that are not short. For [1.2, 1.8] it is 2.4.
 double collapse_length_limit(double m_i, double sigma);
 

@@ -6,8 +6,11 @@
 ///   amin = smallest angle of the two triangles
 /// The edge is flipped only if dev_after < dev_before, amin_after >= f * amin_before, the flip is
 /// topologically legal (is_flip_ok, no vertex left with valence < 3) and folds no triangle (both new
-/// normals agree with both old ones) nor creates a degenerate one. We test before flipping, which
-/// is the same as flipping and undoing.
+/// normals agree with both old ones, within 60 degrees: geom::normals_agree) nor creates a
+/// degenerate one. Not in the thesis: nor may it leave the two new triangles, or either of them and
+/// one of the four triangles around the quad, meeting at a dihedral angle sharper than 60 degrees
+/// when they did not before (geom::adjacent_ok): a flip across a crease would cut it. We test before
+/// flipping, which is the same as flipping and undoing.
 
 #include <algorithm>
 #include <bit>
