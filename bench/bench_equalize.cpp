@@ -31,13 +31,16 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
 #include "bench_common.h"
+#include "core/parallel.h"
 #include "remesh/equalize.h"
 #include "remesh/geometry.h"
+#include "remesh/reference_surface.h"
 #include "remesh/self_intersections.h"
 #ifdef REMESH_BENCH_HAS_CGAL
 #include "cgal_isotropic.h"
@@ -186,6 +189,38 @@ void print_thin_parts(const TriMesh& input, const TriMesh& output, const Options
   std::printf("ours : %zu edges outside; the input's thickness at them: median %.2f (at edges inside: %.2f); %zu of "
               "them where it is below %.2f = 2 e_min / sqrt(3); %zu with an end of valence other than 6\n",
               t[0].size(), median(t[0]), median(t[1]), static_cast<std::size_t>(thin), tube, irregular);
+}
+
+/// Regular vertices by the input's thickness where they lie (the distance to the other side of the
+/// part, ReferenceSurface::opposite_side_distance along the vertex normal): below 2 e_min / sqrt(3),
+/// where no ring of three vertices fits; below 2 e_max; and thicker. A tube a few edges round must
+/// change the number of vertices around it wherever it widens or narrows, and each change is a 5-7
+/// pair: thin tapering parts (legs, horns, tails, cheese's walls) hold irregular vertices that no
+/// flip can remove. Interior vertices, at most 20 000 of them (every k-th).
+void print_regular_by_thickness(const char* who, const ReferenceSurface& input, const TriMesh& output,
+                                const Options& o) {
+  const double limits[2] = {2 * kEmin / std::sqrt(3.0), 2 * kEmax};
+  std::vector<OpenMesh::VertexHandle> sample;
+  const std::size_t stride = std::max<std::size_t>(1, output.n_vertices() / 20000);
+  for (auto v : output.vertices())
+    if (!output.is_boundary(v) && v.idx() % stride == 0) sample.push_back(v);
+  std::vector<int> band(sample.size());
+  parallel_for(sample.size(), o.threads, [&](std::size_t i) {
+    const Vec3 n = geom::vertex_normal(output, sample[i]);
+    const double t = n.norm() > 0 ? input.opposite_side_distance(output.point(sample[i]), n.normalized(), limits[1])
+                                  : std::numeric_limits<double>::infinity();
+    band[i] = t < limits[0] ? 0 : t < limits[1] ? 1 : 2;
+  }, 64);
+  std::size_t total[3] = {}, regular[3] = {};
+  for (std::size_t i = 0; i < sample.size(); ++i) {
+    ++total[band[i]];
+    regular[band[i]] += output.valence(sample[i]) == 6;
+  }
+  auto percent = [&](int b) { return total[b] ? 100.0 * regular[b] / total[b] : 0.0; };
+  std::printf("%-5s: regular vertices by the input's thickness at them: below %.2f = 2 e_min / sqrt(3) %.2f %% of %zu, "
+              "below %.2f = 2 e_max %.2f %% of %zu, thicker %.2f %% of %zu%s\n",
+              who, limits[0], percent(0), total[0], limits[1], percent(1), total[1], percent(2), total[2],
+              stride > 1 ? " (a sample)" : "");
 }
 
 /// The quality row printed for each remesher; returns the Hausdorff distance (% of the bbox diagonal).
@@ -391,6 +426,7 @@ void run_setup(const std::string& path, const char* setup, double mean_edge, con
   const std::string ours_out = (dir / (name + "_ours.off")).string();
   const ChildResult ours = run_ours(scaled, ours_out, kEmin, kEmax, o, true);
   TriMesh input = bench::load_mesh(scaled);
+  const ReferenceSurface input_surface(input);
   double ours_h = 0;  // Hausdorff % of our run
   if (!ours.ok) {
     std::printf("ours : FAILED\n");
@@ -398,6 +434,7 @@ void run_setup(const std::string& path, const char* setup, double mean_edge, con
     const TriMesh output = bench::load_mesh(ours_out);
     ours_h = print_quality("ours", input, output, topo_in, crossings_in, ours, o);
     print_thin_parts(input, output, o);
+    print_regular_by_thickness("ours", input_surface, output, o);
     if (o.spread) run_spread(name, scaled, input, ours, ours_h, o, dir);
   }
 #ifdef REMESH_BENCH_HAS_CGAL
@@ -410,6 +447,7 @@ void run_setup(const std::string& path, const char* setup, double mean_edge, con
     } else {
       const TriMesh cgal_mesh = bench::load_mesh(cgal_out);
       print_quality("cgal", input, cgal_mesh, topo_in, crossings_in, cgal, o);
+      print_regular_by_thickness("cgal", input_surface, cgal_mesh, o);
       if (ours.ok)
         std::printf("ratio ours/cgal: time %.2fx, peak memory %.2fx\n", ours.seconds / cgal.seconds,
                     ours.peak_mib / cgal.peak_mib);
