@@ -62,6 +62,20 @@ JobRecord::StepSeconds step_seconds_from_json(const json& j) {
   return s;
 }
 
+/// {outside, in_thin_parts, limit, at_irregular_vertices, vertices: {limit, thinner: {vertices,
+/// regular}, thicker: {vertices, regular}, sampled}} (thin_parts.h).
+json thin_parts_to_json(const ThinParts& t) {
+  return json{{"outside", t.outside},
+              {"in_thin_parts", t.in_thin_parts},
+              {"limit", t.limit},
+              {"at_irregular_vertices", t.at_irregular},
+              {"vertices",
+               {{"limit", t.vertex_limit},
+                {"thinner", {{"vertices", t.vertices_thinner}, {"regular", t.regular_thinner}}},
+                {"thicker", {{"vertices", t.vertices_thicker}, {"regular", t.regular_thicker}}},
+                {"sampled", t.sampled}}}};
+}
+
 /// {atoms, bonds, rings: {"5": n, "6": n, ...}, bond_length: {mean, deviation, min, max},
 /// bond_interval: [min, max], short_bonds, long_bonds, bonds_inside_fraction}.
 json dual_to_json(const DualStats& d) {
@@ -176,11 +190,7 @@ json job_to_json(const JobRecord& job, std::string_view prefix, double now) {
       {"progress", {{"iteration", job.iteration}, {"iterations", job.params.iterations}}},
       {"latest", job.latest ? json(*job.latest) : json(nullptr)},
       {"outcome", job.outcome ? json(*job.outcome) : json(nullptr)},
-      {"thin_parts", job.thin_parts ? json{{"outside", job.thin_parts->outside},
-                                           {"in_thin_parts", job.thin_parts->in_thin_parts},
-                                           {"limit", job.thin_parts->limit},
-                                           {"at_irregular_vertices", job.thin_parts->at_irregular}}
-                                     : json(nullptr)},
+      {"thin_parts", job.thin_parts ? thin_parts_to_json(*job.thin_parts) : json(nullptr)},
       {"crossing_pairs", job.crossing_pairs ? json(*job.crossing_pairs) : json(nullptr)},
       {"seconds_by_step", job.seconds_by_step ? step_seconds_to_json(*job.seconds_by_step) : json(nullptr)},
       {"dual", job.dual ? dual_to_json(*job.dual) : json(nullptr)},
@@ -221,8 +231,17 @@ JobRecord job_from_json(const json& j) {
     if (const auto t = j.find("thin_parts"); t != j.end() && !t->is_null()) {
       job.thin_parts = ThinParts{t->at("outside").get<std::size_t>(), t->at("in_thin_parts").get<std::size_t>(),
                                  t->at("limit").get<double>()};
-      // Absent in documents written before the count existed: 0 there.
+      // Absent in documents written before the counts existed: 0 there.
       job.thin_parts->at_irregular = t->value("at_irregular_vertices", std::size_t{0});
+      if (const auto v = t->find("vertices"); v != t->end() && v->is_object()) {
+        ThinParts& p = *job.thin_parts;
+        p.vertex_limit = v->at("limit").get<double>();
+        p.vertices_thinner = v->at("thinner").at("vertices").get<std::size_t>();
+        p.regular_thinner = v->at("thinner").at("regular").get<std::size_t>();
+        p.vertices_thicker = v->at("thicker").at("vertices").get<std::size_t>();
+        p.regular_thicker = v->at("thicker").at("regular").get<std::size_t>();
+        p.sampled = v->at("sampled").get<bool>();
+      }
     }
     // Absent in documents written before the field existed.
     if (const auto c = j.find("crossing_pairs"); c != j.end() && !c->is_null())

@@ -133,6 +133,15 @@ void print_final(const TriMesh& mesh, const Job& job, const Result& result, cons
                                             : " (faces passing through each other: where the input crosses itself, "
                                               "or where parts are thinner than the edges)");
   std::printf("  regular vertices:     %.2f %%\n", q.regular_percent);
+  if (const ThinParts& t = result.thin; t.vertices_thinner > 0 && t.vertices_thicker > 0) {
+    auto percent = [](std::size_t part, std::size_t whole) { return 100.0 * double(part) / double(whole); };
+    std::printf("  by thickness:         %.2f %% where the input is at least %g = 2 e_max thick, %.2f %% of the %zu "
+                "vertices%s in thinner parts (a tube a few edges round needs a 5-7 pair wherever it widens or "
+                "narrows)\n",
+                percent(t.regular_thicker, t.vertices_thicker), t.vertex_limit,
+                percent(t.regular_thinner, t.vertices_thinner), t.vertices_thinner,
+                t.sampled ? " of a sample" : "");
+  }
   std::printf("  edge length:          mean %.6g, deviation %.4g, min %.6g, max %.6g\n", q.mean, q.deviation,
               s.min_edge, s.max_edge);
   if (dual) {

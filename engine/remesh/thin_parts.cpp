@@ -1,5 +1,6 @@
 #include "remesh/thin_parts.h"
 
+#include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <vector>
@@ -49,6 +50,26 @@ ThinParts thin_parts(const TriMesh& mesh, const ReferenceSurface& reference, dou
     if (in_thin_part(mesh, reference, outside[i], out.limit)) ++thin;
   }, 64);
   out.in_thin_parts = thin;
+
+  out.vertex_limit = 2.0 * e_max;
+  std::vector<OpenMesh::VertexHandle> sample;
+  const std::size_t stride = std::max<std::size_t>(1, (mesh.n_vertices() + kThicknessSample - 1) / kThicknessSample);
+  out.sampled = stride > 1;
+  for (auto v : mesh.vertices())
+    if (static_cast<std::size_t>(v.idx()) % stride == 0 && !mesh.is_boundary(v) && !mesh.is_isolated(v))
+      sample.push_back(v);
+  std::vector<char> thinner(sample.size(), 0);
+  parallel_for(sample.size(), threads, [&](std::size_t i) {
+    const Vec3 n = geom::vertex_normal(mesh, sample[i]);
+    if (!(n.norm() > 0)) return;
+    thinner[i] = reference.opposite_side_distance(mesh.point(sample[i]), n.normalized(), out.vertex_limit) <
+                 out.vertex_limit;
+  }, 64);
+  for (std::size_t i = 0; i < sample.size(); ++i) {
+    const bool regular = mesh.valence(sample[i]) == 6;
+    if (thinner[i]) ++out.vertices_thinner, out.regular_thinner += regular;
+    else ++out.vertices_thicker, out.regular_thicker += regular;
+  }
   return out;
 }
 

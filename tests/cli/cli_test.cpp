@@ -386,6 +386,41 @@ TEST_CASE("the summary says how many edges outside lie in parts too thin for the
   CHECK(s.out.find("  crossing faces:       0 pairs\n") != std::string::npos);
 }
 
+TEST_CASE("the summary splits the regular vertices by the input's thickness", "[cli]") {
+  TempDir dir;
+  // A lens: a sphere of radius 6 flattened to 3 across at its middle and 0 at its rim, so that
+  // vertices lie both where it is thinner than 2 e_max = 2.8 and where it is not.
+  remesh::TriMesh lens = remesh::test::make_icosphere(4, 6.0);
+  for (auto v : lens.vertices()) lens.point(v)[2] *= 0.25;
+  write_obj(lens, dir.file("lens.obj"));
+  const ProcessResult r = remesh_cli({dir.file("lens.obj"), dir.file("out.obj"), "--emin", "1.0", "--emax", "1.4"});
+  INFO(r.out << r.err);
+  REQUIRE(r.exit_code == 0);
+  // "  by thickness:         X % where the input is at least 2.8 = 2 e_max thick, Y % of the N
+  // vertices in thinner parts (...)"
+  const auto at = r.out.find("  by thickness:");
+  REQUIRE(at != std::string::npos);
+  std::istringstream line(r.out.substr(at + std::string("  by thickness:").size()));
+  double thick = -1, thin = -1, limit = 0;
+  std::size_t n = 0;
+  std::string word;
+  line >> thick >> word >> word >> word >> word >> word >> word >> word >> limit;
+  for (int i = 0; i < 4; ++i) line >> word;  // "= 2 e_max thick,"
+  line >> thin >> word >> word >> word >> n;
+  CHECK(limit == Approx(2.8));
+  CHECK(n > 0);
+  CHECK(thick >= 0);
+  CHECK(thick <= 100);
+  CHECK(thin >= 0);
+  CHECK(thin <= 100);
+  // The share over all vertices lies between the two (every vertex of this mesh is measured).
+  const auto regular_at = r.out.find("  regular vertices:");
+  REQUIRE(regular_at != std::string::npos);
+  const double all = std::stod(r.out.substr(regular_at + std::string("  regular vertices:").size()));
+  CHECK(all >= std::min(thick, thin) - 0.01);
+  CHECK(all <= std::max(thick, thin) + 0.01);
+}
+
 TEST_CASE("the summary says where the time went, step by step, adding up to the run's seconds", "[cli]") {
   TempDir dir;
   write_obj(remesh::test::make_icosphere(3, 4.0), dir.file("sphere.obj"));

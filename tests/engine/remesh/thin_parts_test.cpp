@@ -116,6 +116,69 @@ TEST_CASE("thin_parts counts the edges outside at vertices of valence other than
   CHECK(none.at_irregular == 0);
 }
 
+TEST_CASE("thin_parts counts the regular vertices where the reference is thinner than 2 e_max and elsewhere",
+          "[thin]") {
+  // Each interior vertex is classed by opposite_side_distance along its normal, checked here by
+  // testing every triangle (brute_opposite). The torus's tube is 3 across and its hole 5: thinner
+  // than 2 e_max = 3.6, not than 2.4. The flattened sphere (a lens 1.5 thick at its middle, 0 at
+  // its rim) has both at 2 e_max = 1.
+  struct Case {
+    TriMesh mesh;
+    double e_max;
+  };
+  std::vector<Case> cases;
+  cases.push_back({test::make_torus(48, 16, 4.0, 1.5), 1.8});
+  cases.push_back({test::make_torus(48, 16, 4.0, 1.5), 1.2});
+  TriMesh lens = test::make_icosphere(3, 5.0);
+  for (auto v : lens.vertices()) lens.point(v)[2] *= 0.15;
+  cases.push_back({lens, 0.5});
+  cases.push_back({test::make_icosphere(3, 10.0), 1.8});
+  for (const Case& c : cases) {
+    const TriMesh& m = c.mesh;
+    const ThinParts t = thin_parts(m, ReferenceSurface(m), 0.5 * c.e_max, c.e_max, 2);
+    CHECK(t.vertex_limit == 2 * c.e_max);
+    CHECK_FALSE(t.sampled);
+    std::size_t thinner = 0, regular_thinner = 0, thicker = 0, regular_thicker = 0;
+    for (auto v : m.vertices()) {
+      const bool thin = brute_opposite(m, m.point(v), geom::vertex_normal(m, v).normalized(), t.vertex_limit) <
+                        t.vertex_limit;
+      const bool regular = m.valence(v) == 6;
+      (thin ? thinner : thicker) += 1;
+      (thin ? regular_thinner : regular_thicker) += regular;
+    }
+    CHECK(t.vertices_thinner == thinner);
+    CHECK(t.regular_thinner == regular_thinner);
+    CHECK(t.vertices_thicker == thicker);
+    CHECK(t.regular_thicker == regular_thicker);
+  }
+  // The classes as described: the torus wholly thin at e_max 1.8, wholly thick at 1.2, every
+  // vertex regular; the sphere (20 across) wholly thick with its 12 vertices of valence 5; the
+  // lens both.
+  const ThinParts torus_thin = thin_parts(cases[0].mesh, ReferenceSurface(cases[0].mesh), 0.9, 1.8, 1);
+  CHECK(torus_thin.vertices_thinner == cases[0].mesh.n_vertices());
+  CHECK(torus_thin.regular_thinner == cases[0].mesh.n_vertices());
+  const ThinParts torus_thick = thin_parts(cases[1].mesh, ReferenceSurface(cases[1].mesh), 0.6, 1.2, 1);
+  CHECK(torus_thick.vertices_thicker == cases[1].mesh.n_vertices());
+  const ThinParts sphere = thin_parts(cases[3].mesh, ReferenceSurface(cases[3].mesh), 0.9, 1.8, 1);
+  CHECK(sphere.vertices_thinner == 0);
+  CHECK(sphere.regular_thicker == cases[3].mesh.n_vertices() - 12);
+  const ThinParts lens_parts = thin_parts(cases[2].mesh, ReferenceSurface(cases[2].mesh), 0.25, 0.5, 1);
+  CHECK(lens_parts.vertices_thinner > 0);
+  CHECK(lens_parts.vertices_thicker > 0);
+}
+
+TEST_CASE("thin_parts measures every k-th vertex of a large mesh", "[thin]") {
+  // 24 000 vertices: every 2nd is measured (kThicknessSample = 20 000), all in the tube (0.6
+  // across) and all regular.
+  const TriMesh m = test::make_torus(400, 60, 20.0, 0.3);
+  REQUIRE(m.n_vertices() == 24000);
+  const ThinParts t = thin_parts(m, ReferenceSurface(m), 1.2, 1.8, 2);
+  CHECK(t.sampled);
+  CHECK(t.vertices_thinner == 12000);
+  CHECK(t.regular_thinner == 12000);
+  CHECK(t.vertices_thicker == 0);
+}
+
 TEST_CASE("equalize reports the returned mesh's edges outside and those in thin parts", "[thin]") {
   // A torus whose tube (0.5 across) no ring of edges of at least 1.2 can follow, and a sphere.
   for (const bool thin : {true, false}) {
