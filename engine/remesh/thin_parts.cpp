@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cstdint>
 #include <cmath>
 #include <vector>
 
@@ -55,9 +56,17 @@ ThinParts thin_parts(const TriMesh& mesh, const ReferenceSurface& reference, dou
   std::vector<OpenMesh::VertexHandle> sample;
   const std::size_t stride = std::max<std::size_t>(1, (mesh.n_vertices() + kThicknessSample - 1) / kThicknessSample);
   out.sampled = stride > 1;
+  // Every vertex whose index hashes to 0 modulo the stride: every k-th by index would follow the
+  // order the splits numbered the vertices in (cow: 90.5 % regular where thick against 89.4 % over
+  // all of them).
+  auto picked = [&](std::size_t i) {
+    std::uint64_t x = i + 0x9E3779B97F4A7C15ull;  // splitmix64
+    x = (x ^ (x >> 30)) * 0xBF58476D1CE4E5B9ull;
+    x = (x ^ (x >> 27)) * 0x94D049BB133111EBull;
+    return (x ^ (x >> 31)) % stride == 0;
+  };
   for (auto v : mesh.vertices())
-    if (static_cast<std::size_t>(v.idx()) % stride == 0 && !mesh.is_boundary(v) && !mesh.is_isolated(v))
-      sample.push_back(v);
+    if (picked(static_cast<std::size_t>(v.idx())) && !mesh.is_boundary(v) && !mesh.is_isolated(v)) sample.push_back(v);
   std::vector<char> thinner(sample.size(), 0);
   parallel_for(sample.size(), threads, [&](std::size_t i) {
     const Vec3 n = geom::vertex_normal(mesh, sample[i]);

@@ -33,14 +33,18 @@ struct ThinParts {
   /// walls) hold irregular vertices that no flip can remove. Measured (bench/README.md, "Where the
   /// irregular vertices lie"): where the input is at least 2 e_max thick, the Table 4.2 meshes are
   /// 89.1-90.2 % regular; cow's thin parts, 22 % of its vertices, 71-84 %. At most
-  /// kThicknessSample vertices are measured (every k-th by index): `sampled` says so.
+  /// about kThicknessSample vertices are measured (those whose index hashes to 0 modulo k, for the
+  /// smallest k that leaves at most that many): `sampled` says so.
   double vertex_limit = 0;
   std::size_t vertices_thinner = 0, regular_thinner = 0;
   std::size_t vertices_thicker = 0, regular_thicker = 0;
   bool sampled = false;
 };
 
-/// Vertices thin_parts() measures the thickness at, at most.
+/// Vertices thin_parts() measures the thickness at, at most (about 5 us each: 2 % of cow's refined
+/// run, Table 4.2 setup, 6 121 vertices; 0.1 s of nefertiti's 8). A share estimated from that many
+/// is within half a point; from 5 000 a point (cow: 89.5 % regular where thick against 89.4 %,
+/// spot 88.9 against 89.1 %: the sample made spot look less regular where thick than overall).
 constexpr std::size_t kThicknessSample = 20000;
 
 /// Counts the edges of `mesh` outside [e_min, e_max], those of them in thin parts of `reference`

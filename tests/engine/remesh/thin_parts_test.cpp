@@ -168,15 +168,17 @@ TEST_CASE("thin_parts counts the regular vertices where the reference is thinner
 }
 
 TEST_CASE("thin_parts measures every k-th vertex of a large mesh", "[thin]") {
-  // 24 000 vertices: every 2nd is measured (kThicknessSample = 20 000), all in the tube (0.6
-  // across) and all regular.
+  // 24 000 vertices: about every 2nd is measured (kThicknessSample = 20 000, picked by a hash of
+  // the index), all in the tube (0.6 across) and all regular; the same ones every time.
   const TriMesh m = test::make_torus(400, 60, 20.0, 0.3);
   REQUIRE(m.n_vertices() == 24000);
   const ThinParts t = thin_parts(m, ReferenceSurface(m), 1.2, 1.8, 2);
   CHECK(t.sampled);
-  CHECK(t.vertices_thinner == 12000);
-  CHECK(t.regular_thinner == 12000);
+  CHECK(t.vertices_thinner > 11000);
+  CHECK(t.vertices_thinner < 13000);
+  CHECK(t.regular_thinner == t.vertices_thinner);
   CHECK(t.vertices_thicker == 0);
+  CHECK(thin_parts(m, ReferenceSurface(m), 1.2, 1.8, 1).vertices_thinner == t.vertices_thinner);
 }
 
 TEST_CASE("equalize reports the returned mesh's edges outside and those in thin parts", "[thin]") {
