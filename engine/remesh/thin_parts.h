@@ -32,7 +32,7 @@ struct ThinParts {
   /// change is a 5-7 pair (a dislocation of the lattice): thin tapering parts (legs, horns, tails,
   /// walls) hold irregular vertices that no flip can remove. Measured (bench/README.md, "Where the
   /// irregular vertices lie"): where the input is at least 2 e_max thick, the Table 4.2 meshes are
-  /// 89.1-90.2 % regular; cow's thin parts, 22 % of its vertices, 71-84 %. At most
+  /// 89.1-90.1 % regular; cow's thin parts, 22 % of its vertices, 71-84 %. At most
   /// about kThicknessSample vertices are measured (those whose index hashes to 0 modulo k, for the
   /// smallest k that leaves at most that many): `sampled` says so.
   double vertex_limit = 0;
