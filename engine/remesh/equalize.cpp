@@ -114,17 +114,18 @@ constexpr double kCleanupFrom = 0.97;
 /// Iterations of the interval cleanup after which the filter and projection (Alg. 5 and 6) may no
 /// longer take an edge out of the interval: a vertex whose move does goes half way back, up to
 /// three times, then all the way (undo_interval_breaks, fold_guard.h). Until then only the fold
-/// guard holds them back, as in every iteration. In a run that stalls, they took ~540 edges out of the interval in every
-/// iteration (cow refinement, iterations 15-31: 5-30 edges outside after the stellar operations
-/// and flips, ~550 after the filter and projection), which the cleanup then mended again; the
-/// edges it could not mend wandered, and so did the tips it cut. Measured (Table 4.2 setup, the
-/// means over the five intervals of bench --spread, Hausdorff in % of the bbox diagonal; before ->
-/// after, with kExploreAfter): cow refinement 1.43 -> 1.22 (worst 1.86 -> 1.29), cheese 3.77 ->
-/// 2.90 (worst 4.80 -> 3.13) and 2.60 -> 1.84 s; simplification: cow 93.4 -> 94.5 % inside,
-/// cheese 6.3 -> 4.7 s; cheese's regular vertices 69.4 -> 67.2 %, bunny's simplified 85.1 -> 84.2 %.
-/// Runs that converge within kSteadyAfter iterations of the cleanup (spot, bunny, eight, kitten)
-/// give the same meshes. Guarding from the cleanup's start on cost regularity (eight 86.5 %, cow
-/// 86.9 % in single runs): the smoothing it holds back; after 2 or 5 iterations it gained less.
+/// guard holds them back, as in every iteration. In a run that stalls, they took ~540 edges out of
+/// the interval in every iteration (cow refinement, iterations 15-31: 5-30 edges outside after the
+/// stellar operations and flips, ~550 after the filter and projection), which the cleanup then
+/// mended again; the edges it could not mend wandered, and so did the tips it cut. Measured (Table
+/// 4.2 setup, the means over the five intervals of bench --spread, Hausdorff in % of the bbox
+/// diagonal; before -> after, with kExploreAfter): cow refinement 1.43 -> 1.22 (worst 1.86 ->
+/// 1.29), cheese 3.77 -> 2.90 (worst 4.80 -> 3.13) and 2.60 -> 1.84 s; simplification: cow 93.4 ->
+/// 94.5 % inside, cheese 6.3 -> 4.7 s; cheese's regular vertices 69.4 -> 67.2 %, bunny's simplified
+/// 85.1 -> 84.2 %. Runs that converge within kSteadyAfter iterations of the cleanup (spot, bunny,
+/// eight, kitten) give the same meshes. Guarding from the cleanup's start on cost regularity (eight
+/// 86.5 %, cow 86.9 % in single runs): the smoothing it holds back; after 2 or 5 iterations it
+/// gained less.
 constexpr int kSteadyAfter = 3;
 /// ... unless the run has reached no new low of edges outside for this many iterations: then the
 /// filter moves freely again, until the next low. Its churn is what lets the cleanup find another

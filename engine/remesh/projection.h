@@ -5,7 +5,8 @@
 /// Not in the thesis: boundary vertices go to the closest point of the reference's boundary curves
 /// (the boundary edges at their 30 nearest reference vertices), so boundaries stay boundaries.
 /// Where two sheets are close, the candidate whose normal agrees with the vertex normal wins
-/// (ALGORITHM.md: prefer it). Parallel over vertices; each vertex's result depends only on the mesh before the step.
+/// (ALGORITHM.md: prefer it). Parallel over vertices; each vertex's result depends only on the
+/// mesh before the step.
 
 #include <vector>
 

@@ -95,8 +95,9 @@ OpenMesh::VertexHandle apply_collapse(TriMesh& mesh, const CollapsePlan& plan);
 /// bound refuses 99 % of the collapses of short edges once the mesh is near the target (a short edge
 /// between ordinary ones has far neighbours at about 1.4 m_i from the merged vertex), the mesh stays
 /// 7 % too dense and ends at 95.9 % inside / 80.7 % regular; without any bound it ends at 99.7 % /
-/// 88.3 % (the thesis, on its Fertility model: 99.65 % / 89.6 %). 2 (m_i - sigma) keeps a bound with a reason: an edge up to
-/// that long splits into two halves that are not short. For [1.2, 1.8] it is 2.4.
+/// 88.3 % (the thesis, on its Fertility model: 99.65 % / 89.6 %). 2 (m_i - sigma) keeps a bound
+/// with a reason: an edge up to that long splits into two halves that are not short. For
+/// [1.2, 1.8] it is 2.4.
 double collapse_length_limit(double m_i, double sigma);
 
 struct StellarCounts {

@@ -54,7 +54,8 @@ ThinParts thin_parts(const TriMesh& mesh, const ReferenceSurface& reference, dou
 
   out.vertex_limit = 2.0 * e_max;
   std::vector<OpenMesh::VertexHandle> sample;
-  const std::size_t stride = std::max<std::size_t>(1, (mesh.n_vertices() + kThicknessSample - 1) / kThicknessSample);
+  const std::size_t stride =
+      std::max<std::size_t>(1, (mesh.n_vertices() + kThicknessSample - 1) / kThicknessSample);
   out.sampled = stride > 1;
   // Every vertex whose index hashes to 0 modulo the stride: every k-th by index would follow the
   // order the splits numbered the vertices in (cow: 90.5 % regular where thick against 89.4 % over
@@ -66,7 +67,8 @@ ThinParts thin_parts(const TriMesh& mesh, const ReferenceSurface& reference, dou
     return (x ^ (x >> 31)) % stride == 0;
   };
   for (auto v : mesh.vertices())
-    if (picked(static_cast<std::size_t>(v.idx())) && !mesh.is_boundary(v) && !mesh.is_isolated(v)) sample.push_back(v);
+    if (picked(static_cast<std::size_t>(v.idx())) && !mesh.is_boundary(v) && !mesh.is_isolated(v))
+      sample.push_back(v);
   std::vector<char> thinner(sample.size(), 0);
   parallel_for(sample.size(), threads, [&](std::size_t i) {
     const Vec3 n = geom::vertex_normal(mesh, sample[i]);
