@@ -201,20 +201,20 @@ void print_thin_parts(const TriMesh& input, const TriMesh& output, const Options
 void print_regular_by_thickness(const char* who, const ReferenceSurface& input, const TriMesh& output,
                                 const Options& o) {
   const double limits[2] = {2 * kEmin / std::sqrt(3.0), 2 * kEmax};
-  std::vector<OpenMesh::VertexHandle> sample;
+  std::vector<OpenMesh::VertexHandle> interior;
   for (auto v : output.vertices())
-    if (!output.is_boundary(v)) sample.push_back(v);
-  std::vector<int> band(sample.size());
-  parallel_for(sample.size(), o.threads, [&](std::size_t i) {
-    const Vec3 n = geom::vertex_normal(output, sample[i]);
-    const double t = n.norm() > 0 ? input.opposite_side_distance(output.point(sample[i]), n.normalized(), limits[1])
+    if (!output.is_boundary(v)) interior.push_back(v);
+  std::vector<int> band(interior.size());
+  parallel_for(interior.size(), o.threads, [&](std::size_t i) {
+    const Vec3 n = geom::vertex_normal(output, interior[i]);
+    const double t = n.norm() > 0 ? input.opposite_side_distance(output.point(interior[i]), n.normalized(), limits[1])
                                   : std::numeric_limits<double>::infinity();
     band[i] = t < limits[0] ? 0 : t < limits[1] ? 1 : 2;
   }, 64);
   std::size_t total[3] = {}, regular[3] = {};
-  for (std::size_t i = 0; i < sample.size(); ++i) {
+  for (std::size_t i = 0; i < interior.size(); ++i) {
     ++total[band[i]];
-    regular[band[i]] += output.valence(sample[i]) == 6;
+    regular[band[i]] += output.valence(interior[i]) == 6;
   }
   auto percent = [&](int b) { return total[b] ? 100.0 * regular[b] / total[b] : 0.0; };
   std::printf("%-5s: regular vertices by the input's thickness at them: below %.2f = 2 e_min / sqrt(3) %.2f %% of %zu, "
