@@ -118,6 +118,11 @@ async function main() {
   check(job_doc.dual && dual_line.startsWith(`dual: ${job_doc.dual.atoms.toLocaleString('en-US')} atoms, ${job_doc.dual.bonds.toLocaleString('en-US')} bonds · rings `) &&
     / % inside \[[\d.]+, [\d.]+\] = \[emin, emax\] \/ √3 \([\d,]+ short, [\d,]+ long\)$/.test(dual_line),
     `the dual's atoms, rings and bonds shown once succeeded (${dual_line})`);
+  const by = job_doc.thin_parts?.vertices;
+  const progress_text = await page.textContent('#progress-text');
+  const both = Boolean(by && by.thinner.vertices > 0 && by.thicker.vertices > 0);
+  check(both === / % regular where the input is at least [\d.]+ thick, [\d.]+ % in thinner parts/.test(progress_text),
+    `regular vertices by thickness shown exactly when the job document has both kinds (${JSON.stringify(by)})`);
   const summary_text = await page.textContent('#summary');
   check(/server summary/.test(summary_text) && /genus/.test(summary_text), 'server summary with genus replaces the local one');
 
@@ -161,6 +166,21 @@ async function main() {
   check(await page.$$eval('#rows tbody tr', (t) => t.length) === rows.length, 'after a reload the table holds every row again');
   const listed = await page.$$eval('#jobs li', (lis) => lis.map((li) => li.dataset.id));
   check(listed.includes(job_id), 'the job is in the recent-jobs list');
+
+  // --- a lens (a sphere of radius 6 flattened to 3 across: thick in its middle, thin at its rim),
+  // started over the API and opened by its address: the regular vertices by the input's thickness ---
+  const lens = icosphere_obj(4).replace(/^v (\S+) (\S+) (\S+)$/gm, (_, x, y, z) => `v ${6 * x} ${6 * y} ${1.5 * z}`);
+  const lens_id = await api_post_job(base, lens, { emin: 1.0, emax: 1.4 });
+  check(await wait_state(base, lens_id, ['succeeded']), `lens job ${lens_id} succeeded`);
+  await page.evaluate((id) => { location.hash = `job=${id}`; }, lens_id);
+  const lens_shown = await page.waitForFunction(() => / % in thinner parts/.test(document.getElementById('progress-text').textContent),
+    null, { timeout: 10000 }).then(() => true, () => false);
+  const lens_by = (await (await fetch(`${base}/api/v1/jobs/${lens_id}`)).json()).thin_parts?.vertices;
+  const lens_text = await page.textContent('#progress-text');
+  const lens_share = (part) => (100 * part.regular / part.vertices).toFixed(1);
+  check(lens_shown && lens_by && lens_text.includes(`${lens_share(lens_by.thicker)} % regular where the input is at least ` +
+    `${lens_by.limit.toPrecision(3)} thick, ${lens_share(lens_by.thinner)} % in thinner parts`),
+    `the lens's regular vertices by thickness shown as its job document has them (${JSON.stringify(lens_by)})`);
 
   // --- garbage: the server's reader message appears ---
   await page.setInputFiles('#file', garbage_path);

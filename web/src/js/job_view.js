@@ -215,6 +215,14 @@ export class JobView {
     if (thin && thin.outside > 0)
       text += ` · ${thin.outside} edges outside, ${thin.in_thin_parts} of them where the input is thinner than ${thin.limit.toPrecision(3)}` +
         (thin.at_irregular_vertices !== undefined ? `, ${thin.at_irregular_vertices} at vertices of valence other than 6` : '');
+    // Regular vertices where the input is thick and in its thin parts (a tube a few edges round
+    // needs a 5-7 pair wherever it widens or narrows), when the result has both.
+    const by = thin?.vertices;
+    if (by && by.thinner.vertices > 0 && by.thicker.vertices > 0) {
+      const share = (part) => (100 * part.regular / part.vertices).toFixed(1);
+      text += ` · ${share(by.thicker)} % regular where the input is at least ${by.limit.toPrecision(3)} thick, ` +
+        `${share(by.thinner)} % in thinner parts`;
+    }
     if (job.crossing_pairs > 0) text += ` · ${job.crossing_pairs} pairs of faces crossing each other`;
     const secs = this.rows.reduce((s, r) => s + (r.seconds || 0), 0);
     if (secs) text += ` · ${secs.toFixed(1)} s`;
