@@ -31,7 +31,6 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
-#include <limits>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -42,6 +41,7 @@
 #include "remesh/geometry.h"
 #include "remesh/reference_surface.h"
 #include "remesh/self_intersections.h"
+#include "remesh/thin_parts.h"
 #ifdef REMESH_BENCH_HAS_CGAL
 #include "cgal_isotropic.h"
 #endif
@@ -191,8 +191,7 @@ void print_thin_parts(const TriMesh& input, const TriMesh& output, const Options
               t[0].size(), median(t[0]), median(t[1]), static_cast<std::size_t>(thin), tube, irregular);
 }
 
-/// Regular vertices by the input's thickness where they lie (the distance to the other side of the
-/// part, ReferenceSurface::opposite_side_distance along the vertex normal): below 2 e_min / sqrt(3),
+/// Regular vertices by the input's thickness where they lie (thickness_at in thin_parts.h): below 2 e_min / sqrt(3),
 /// where no ring of three vertices fits; below 2 e_max; and thicker. A tube a few edges round must
 /// change the number of vertices around it wherever it widens or narrows, and each change is a 5-7
 /// pair: thin tapering parts (legs, horns, tails, cheese's walls) hold irregular vertices that no
@@ -206,9 +205,7 @@ void print_regular_by_thickness(const char* who, const ReferenceSurface& input, 
     if (!output.is_boundary(v)) interior.push_back(v);
   std::vector<int> band(interior.size());
   parallel_for(interior.size(), o.threads, [&](std::size_t i) {
-    const Vec3 n = geom::vertex_normal(output, interior[i]);
-    const double t = n.norm() > 0 ? input.opposite_side_distance(output.point(interior[i]), n.normalized(), limits[1])
-                                  : std::numeric_limits<double>::infinity();
+    const double t = thickness_at(output, input, interior[i], limits[1]);
     band[i] = t < limits[0] ? 0 : t < limits[1] ? 1 : 2;
   }, 64);
   std::size_t total[3] = {}, regular[3] = {};

@@ -4,6 +4,7 @@
 #include <atomic>
 #include <cstdint>
 #include <cmath>
+#include <limits>
 #include <vector>
 
 #include "core/parallel.h"
@@ -29,6 +30,12 @@ bool in_thin_part(const TriMesh& mesh, const ReferenceSurface& reference, OpenMe
 }
 
 }  // namespace
+
+double thickness_at(const TriMesh& mesh, const ReferenceSurface& reference, OpenMesh::VertexHandle v, double limit) {
+  const Vec3 n = geom::vertex_normal(mesh, v);
+  if (!(n.norm() > 0)) return std::numeric_limits<double>::infinity();
+  return reference.opposite_side_distance(mesh.point(v), n.normalized(), limit);
+}
 
 ThinParts thin_parts(const TriMesh& mesh, const ReferenceSurface& reference, double e_min, double e_max,
                      unsigned threads) {
@@ -71,10 +78,7 @@ ThinParts thin_parts(const TriMesh& mesh, const ReferenceSurface& reference, dou
       sample.push_back(v);
   std::vector<char> thinner(sample.size(), 0);
   parallel_for(sample.size(), threads, [&](std::size_t i) {
-    const Vec3 n = geom::vertex_normal(mesh, sample[i]);
-    if (!(n.norm() > 0)) return;
-    thinner[i] = reference.opposite_side_distance(mesh.point(sample[i]), n.normalized(), out.vertex_limit) <
-                 out.vertex_limit;
+    thinner[i] = thickness_at(mesh, reference, sample[i], out.vertex_limit) < out.vertex_limit;
   }, 64);
   for (std::size_t i = 0; i < sample.size(); ++i) {
     const bool regular = mesh.valence(sample[i]) == 6;

@@ -47,6 +47,11 @@ struct ThinParts {
 /// spot 88.9 against 89.1 %: the sample made spot look less regular where thick than overall).
 constexpr std::size_t kThicknessSample = 20000;
 
+/// The reference's thickness at vertex v of `mesh`: the distance from v to the nearest reference
+/// triangle facing the other way, along v's normal (ReferenceSurface::opposite_side_distance); only
+/// triangles nearer than `limit` count. Infinity when there is none, or v's normal is zero.
+double thickness_at(const TriMesh& mesh, const ReferenceSurface& reference, OpenMesh::VertexHandle v, double limit);
+
 /// Counts the edges of `mesh` outside [e_min, e_max], those of them in thin parts of `reference`
 /// (see the file comment) and those at irregular vertices, and the regular vertices by the
 /// reference's thickness (ThinParts::vertex_limit), on up to `threads` threads.
