@@ -70,6 +70,14 @@ struct ReferenceSurface::Impl {
     double radius = 0;
   };
   std::vector<Star> stars;
+  /// Per vertex: a cone around its triangles' unit normals (unit axis, cosine and sine of the
+  /// half-angle; a half-angle of pi when the normals have no common direction), for
+  /// opposite_side's test of a whole vertex (with the early stop: thin_parts.h's figures).
+  struct Cone {
+    Vec3 axis{0, 0, 0};
+    double cos_half = -1, sin_half = 0;
+  };
+  std::vector<Cone> cones;
   /// opposite_side_distance's search: the vertices within limit + search_reach of the query find
   /// every triangle whose longest edge is at most search_reach (a point of a triangle lies within
   /// its longest edge of each corner); the longer triangles, a hundredth of them, are in
@@ -158,6 +166,7 @@ struct ReferenceSurface::Impl {
   Vec3 closest_point(const Vec3& p, const Vec3& normal_hint, const std::uint32_t* idx, std::size_t found) const;
   void walk(const Vec3& p, const Vec3& normal_hint, std::uint32_t& t, Vec3& c, double& d2, Seen& seen,
             std::uint32_t epoch) const;
+  double opposite_side(const Vec3& p, const Vec3& normal, double limit, bool first) const;
 };
 
 ReferenceSurface::ReferenceSurface(const TriMesh& mesh, std::size_t neighbours)
@@ -254,6 +263,28 @@ ReferenceSurface::ReferenceSurface(const TriMesh& mesh, std::size_t neighbours)
       for (auto c : m.triangles[*t].corners) r2 = std::max(r2, (m.points[c] - star.centre).sqrnorm());
     star.radius = std::sqrt(r2) * (1 + 1e-9) + 1e-12;  // a margin against rounding
   }
+  m.cones.resize(nv);
+  for (std::size_t v = 0; v < nv; ++v) {
+    Vec3 sum(0, 0, 0);
+    for (std::uint32_t j = m.vertex_triangles.offsets[v]; j < m.vertex_triangles.offsets[v + 1]; ++j)
+      sum += m.triangles[m.vertex_triangles.items[j]].normal;
+    const double len = sum.norm();
+    if (!(len > 1e-9)) continue;  // the whole sphere of directions
+    Impl::Cone& cone = m.cones[v];
+    cone.axis = sum / len;
+    double c = 1;
+    for (std::uint32_t j = m.vertex_triangles.offsets[v]; j < m.vertex_triangles.offsets[v + 1]; ++j) {
+      const Vec3& n = m.triangles[m.vertex_triangles.items[j]].normal;
+      if (n.sqrnorm() > 0) c = std::min(c, n | cone.axis);
+    }
+    c -= 1e-9;  // a margin against rounding
+    if (c <= -1) {
+      cone = Impl::Cone{};
+      continue;
+    }
+    cone.cos_half = c;
+    cone.sin_half = std::sqrt(std::max(0.0, 1.0 - c * c));
+  }
   // A triangle whose normal is nearly opposite to that of a larger neighbour across an edge lies
   // folded back onto it: a defect of the input (nefertiti has 96 such pairs: slivers that close
   // T-junctions of its base with their third corner on the wrong side). Its normal is noise, and a
@@ -305,37 +336,80 @@ std::size_t ReferenceSurface::n_vertices() const { return impl_->points.size(); 
 std::size_t ReferenceSurface::n_triangles() const { return impl_->triangles.size(); }
 bool ReferenceSurface::has_boundary() const { return impl_->boundary_edges > 0; }
 
-double ReferenceSurface::opposite_side_distance(const Vec3& p, const Vec3& normal, double limit) const {
-  const Impl& m = *impl_;
+namespace {
+
+/// A nanoflann result set that hands each point within sqrt(*radius2) of the query to `visit(index,
+/// squared distance)` as the search finds it, keeping none; the search stops when visit returns
+/// false, and prunes by *radius2, which visit may shrink.
+template <class Visit>
+struct VisitEach {
+  double* radius2;
+  Visit* visit;
+  void init() {}
+  std::size_t size() const { return 0; }
+  bool full() const { return true; }
+  double worstDist() const { return *radius2; }
+  bool addPoint(double d2, std::uint32_t i) { return (*visit)(i, d2); }
+};
+
+}  // namespace
+
+/// opposite_side_distance's search. With `first`, it stops at the first triangle nearer than
+/// `limit` (whose distance it returns, not the least).
+double ReferenceSurface::Impl::opposite_side(const Vec3& p, const Vec3& normal, double limit, bool first) const {
   constexpr double kOpposite = -0.3;
   if (!(limit > 0)) return std::numeric_limits<double>::infinity();
   double best2 = limit * limit;
   bool any = false;
-  auto consider = [&](const Impl::Triangle& tri) {
+  auto consider = [&](const Triangle& tri) {
     if ((tri.normal | normal) >= kOpposite) return;
     // Every point of the triangle lies within its radius of its centre (the margin keeps the test
     // conservative against rounding).
     const double reach = (std::sqrt(best2) + tri.radius) * (1.0 + 1e-9);
     if ((tri.centre - p).sqrnorm() > reach * reach) return;
-    const Vec3 c = geom::closest_point_on_triangle(p, m.points[tri.corners[0]], m.points[tri.corners[1]],
-                                                   m.points[tri.corners[2]]);
+    const Vec3 c = geom::closest_point_on_triangle(p, points[tri.corners[0]], points[tri.corners[1]],
+                                                   points[tri.corners[2]]);
     const double c2 = (c - p).sqrnorm();
     if (c2 < best2) best2 = c2, any = true;
   };
-  // A triangle nearer than `limit` has every corner v within limit + vertex_reach[v] of p; those
-  // with an edge longer than search_reach are looked at from the list (Impl::search_reach).
-  std::vector<std::pair<std::uint32_t, double>> found;
+  // A triangle nearer than `limit` (later: than the nearest found) has every corner v within that
+  // distance plus vertex_reach[v] of p; those with an edge longer than search_reach are looked at
+  // from the list (Impl::search_reach).
+  double radius2 = (limit + search_reach) * (limit + search_reach);
+  auto visit = [&](std::uint32_t v, double d2) {
+    const double reach = std::sqrt(best2) + vertex_reach[v];
+    if (d2 > reach * reach) return true;
+    // Passed over whole: a star that lies farther than the nearest found, or whose triangles all
+    // face too much the same way as `normal` (its cone: their normals lie within its half-angle
+    // of its axis, so none is more than the axis' angle to `normal` plus that half-angle from it).
+    const Star& star = stars[v];
+    const double star_reach = std::sqrt(best2) + star.radius;
+    if ((star.centre - p).sqrnorm() > star_reach * star_reach) return true;
+    const Cone& cone = cones[v];
+    const double ca = cone.axis | normal, sa = std::sqrt(std::max(0.0, 1.0 - ca * ca));
+    if (ca * cone.sin_half + sa * cone.cos_half > 1e-9 && ca * cone.cos_half - sa * cone.sin_half >= kOpposite + 1e-9)
+      return true;
+    for (std::uint32_t j = vertex_triangles.offsets[v]; j < vertex_triangles.offsets[v + 1]; ++j)
+      consider(triangles[vertex_triangles.items[j]]);
+    if (any && first) return false;
+    const double r = std::sqrt(best2) + search_reach;
+    radius2 = std::min(radius2, r * r);
+    return true;
+  };
+  VisitEach<decltype(visit)> each{&radius2, &visit};
   const double q[3] = {p[0], p[1], p[2]};
-  const double radius = limit + m.search_reach;
-  m.tree->radiusSearch(q, radius * radius, found, nanoflann::SearchParams(32, 0.0f, false));
-  for (const auto& [v, d2] : found) {
-    const double reach = limit + m.vertex_reach[v];
-    if (d2 > reach * reach) continue;
-    for (std::uint32_t j = m.vertex_triangles.offsets[v]; j < m.vertex_triangles.offsets[v + 1]; ++j)
-      consider(m.triangles[m.vertex_triangles.items[j]]);
-  }
-  for (std::uint32_t t : m.long_triangles) consider(m.triangles[t]);
+  tree->findNeighbors(each, q, nanoflann::SearchParams(32, 0.0f, false));
+  if (!(any && first))
+    for (std::uint32_t t : long_triangles) consider(triangles[t]);
   return any ? std::sqrt(best2) : std::numeric_limits<double>::infinity();
+}
+
+double ReferenceSurface::opposite_side_distance(const Vec3& p, const Vec3& normal, double limit) const {
+  return impl_->opposite_side(p, normal, limit, /*first=*/false);
+}
+
+bool ReferenceSurface::opposite_side_within(const Vec3& p, const Vec3& normal, double limit) const {
+  return impl_->opposite_side(p, normal, limit, /*first=*/true) < limit;
 }
 
 std::size_t ReferenceSurface::nearest_vertices(const Vec3& p, std::size_t k, std::uint32_t* out) const {

@@ -60,6 +60,9 @@ class ReferenceSurface {
   /// the triangle's unit normal n with n . normal < -0.3): the other side of the part p lies on.
   /// Only triangles nearer than `limit` are looked at; infinity when there is none.
   double opposite_side_distance(const Vec3& p, const Vec3& normal, double limit) const;
+  /// Whether opposite_side_distance(p, normal, limit) < limit: the same test, stopped at the
+  /// first such triangle.
+  bool opposite_side_within(const Vec3& p, const Vec3& normal, double limit) const;
 
   /// True when the reference has at least one boundary edge.
   bool has_boundary() const;

@@ -26,7 +26,7 @@ bool in_thin_part(const TriMesh& mesh, const ReferenceSurface& reference, OpenMe
     }
   if (!(normal.norm() > 0)) return false;
   const Vec3 mid = 0.5 * (mesh.point(mesh.from_vertex_handle(h)) + mesh.point(mesh.to_vertex_handle(h)));
-  return reference.opposite_side_distance(mid, normal.normalized(), limit) < limit;
+  return reference.opposite_side_within(mid, normal.normalized(), limit);
 }
 
 }  // namespace
@@ -35,6 +35,11 @@ double thickness_at(const TriMesh& mesh, const ReferenceSurface& reference, Open
   const Vec3 n = geom::vertex_normal(mesh, v);
   if (!(n.norm() > 0)) return std::numeric_limits<double>::infinity();
   return reference.opposite_side_distance(mesh.point(v), n.normalized(), limit);
+}
+
+bool thinner_than(const TriMesh& mesh, const ReferenceSurface& reference, OpenMesh::VertexHandle v, double limit) {
+  const Vec3 n = geom::vertex_normal(mesh, v);
+  return n.norm() > 0 && reference.opposite_side_within(mesh.point(v), n.normalized(), limit);
 }
 
 ThinParts thin_parts(const TriMesh& mesh, const ReferenceSurface& reference, double e_min, double e_max,
@@ -78,7 +83,7 @@ ThinParts thin_parts(const TriMesh& mesh, const ReferenceSurface& reference, dou
       sample.push_back(v);
   std::vector<char> thinner(sample.size(), 0);
   parallel_for(sample.size(), threads, [&](std::size_t i) {
-    thinner[i] = thickness_at(mesh, reference, sample[i], out.vertex_limit) < out.vertex_limit;
+    thinner[i] = thinner_than(mesh, reference, sample[i], out.vertex_limit);
   }, 64);
   for (std::size_t i = 0; i < sample.size(); ++i) {
     const bool regular = mesh.valence(sample[i]) == 6;

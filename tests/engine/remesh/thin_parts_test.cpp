@@ -34,7 +34,7 @@ double brute_opposite(const TriMesh& m, const Vec3& p, const Vec3& normal, doubl
 
 }  // namespace
 
-TEST_CASE("opposite_side_distance is the nearest triangle facing the other way within the limit", "[thin]") {
+TEST_CASE("opposite_side_distance is the nearest triangle facing the other way within the limit, opposite_side_within whether there is one", "[thin]") {
   std::mt19937 rng(7);
   std::uniform_real_distribution<double> limit_of(0.05, 4.0), jitter(-0.2, 0.2), coordinate(-1.0, 1.0);
   // An uneven reference: a sphere with a spike, whose five triangles are far longer than the rest
@@ -69,6 +69,8 @@ TEST_CASE("opposite_side_distance is the nearest triangle facing the other way w
       const double limit = limit_of(rng);
       const double got = reference.opposite_side_distance(p, n, limit);
       const double want = brute_opposite(m, p, n, limit);
+      // The search that stops at the first such triangle answers the same question.
+      CHECK(reference.opposite_side_within(p, n, limit) == (want < limit));
       if (std::isinf(want)) {
         CHECK(std::isinf(got));
       } else {
