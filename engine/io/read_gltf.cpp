@@ -100,13 +100,25 @@ AccessorView view_of(const tinygltf::Model& model, int index, const std::string&
   if (v.buffer < 0 || static_cast<std::size_t>(v.buffer) >= model.buffers.size())
     fail("glTF: bufferView " + std::to_string(a.bufferView) + " refers to a missing buffer");
   const auto& data = model.buffers[static_cast<std::size_t>(v.buffer)].data;
+  // Every sum and product checked before it is formed: offsets near 2^64 would wrap round and
+  // pass a test of the sum, and the reads would land before the buffer.
   const std::uint64_t stride = v.byteStride ? v.byteStride : elem_size;
-  const std::uint64_t start = static_cast<std::uint64_t>(v.byteOffset) + a.byteOffset;
-  const std::uint64_t view_end = static_cast<std::uint64_t>(v.byteOffset) + v.byteLength;
-  if (stride < elem_size || view_end > data.size() || a.count > data.size() ||
-      (a.count > 0 && start + stride * (a.count - 1) + elem_size > view_end))
-    fail("glTF: " + what + " accessor " + std::to_string(index) + " reaches past the end of its buffer data");
-  return {data.data() + start, static_cast<std::size_t>(stride), a.count};
+  const std::uint64_t size = data.size(), view_offset = v.byteOffset, view_length = v.byteLength,
+                      offset = a.byteOffset;
+  if (view_offset > size || view_length > size - view_offset)
+    fail("glTF: bufferView " + std::to_string(a.bufferView) + " reaches past the end of its buffer (offset " +
+         std::to_string(view_offset) + ", length " + std::to_string(view_length) + ", buffer " +
+         std::to_string(size) + " bytes)");
+  bool fits = stride >= elem_size && offset <= view_length;
+  if (fits && a.count > 0) {
+    const std::uint64_t room = view_length - offset;  // bytes of the view from the accessor's first element
+    fits = room >= elem_size && a.count - 1 <= (room - elem_size) / stride;
+  }
+  if (!fits)
+    fail("glTF: " + what + " accessor " + std::to_string(index) + " reaches past the end of its bufferView (offset " +
+         std::to_string(offset) + ", " + std::to_string(a.count) + " elements of stride " + std::to_string(stride) +
+         ", view " + std::to_string(view_length) + " bytes)");
+  return {data.data() + view_offset + offset, static_cast<std::size_t>(stride), a.count};
 }
 
 class Collector {

@@ -260,3 +260,51 @@ TEST_CASE("A file given under another format's name says what its content looks 
   CHECK(read_as(ply).mesh.n_faces() == 20);
   CHECK_THROWS_WITH(read_as("# nothing\n", Format::Obj), Catch::Contains("holds no vertices and no faces"));
 }
+
+TEST_CASE("GLB: accessor and bufferView offsets whose sums wrap round 2^64 are refused, not read") {
+  // A tetrahedron's 4 positions and 12 short indices, then padding: the bounds of the POSITION
+  // accessor are the test's. With an unchecked sum, an offset near 2^64 wrapped round to a small
+  // number, passed the test and made the reader take bytes from before the buffer (a crash in the
+  // daemon, or heap contents read as coordinates).
+  auto glb = [](const std::string& view_offset, const std::string& stride, const std::string& offset,
+                const std::string& count) {
+    std::string bin;
+    for (float v : {0.f, 0.f, 0.f, 1.f, 0.f, 0.f, 0.f, 1.f, 0.f, 0.f, 0.f, 1.f})
+      bin.append(reinterpret_cast<const char*>(&v), 4);
+    for (std::uint16_t i : {0, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3}) bin.append(reinterpret_cast<const char*>(&i), 2);
+    bin.append(1000, '\0');
+    while (bin.size() % 4) bin.push_back('\0');
+    std::string json = R"({"asset":{"version":"2.0"},"scene":0,"scenes":[{"nodes":[0]}],"nodes":[{"mesh":0}],
+      "meshes":[{"primitives":[{"attributes":{"POSITION":0},"indices":1}]}],
+      "buffers":[{"byteLength":)" + std::to_string(bin.size()) + R"(}],
+      "bufferViews":[{"buffer":0,"byteOffset":)" + view_offset + R"(,"byteLength":48)" +
+                       (stride.empty() ? "" : ",\"byteStride\":" + stride) + R"(},
+                     {"buffer":0,"byteOffset":48,"byteLength":24}],
+      "accessors":[{"bufferView":0,"byteOffset":)" + offset + R"(,"componentType":5126,"count":)" + count +
+                       R"(,"type":"VEC3"},
+                   {"bufferView":1,"componentType":5123,"count":12,"type":"SCALAR"}]})";
+    while (json.size() % 4) json.push_back(' ');
+    std::string out = "glTF";
+    auto put32 = [&](std::uint32_t v) { out.append(reinterpret_cast<const char*>(&v), 4); };
+    put32(2);
+    put32(static_cast<std::uint32_t>(12 + 8 + json.size() + 8 + bin.size()));
+    put32(static_cast<std::uint32_t>(json.size()));
+    out += "JSON" + json;
+    put32(static_cast<std::uint32_t>(bin.size()));
+    out += std::string("BIN\0", 4) + bin;
+    return out;
+  };
+  // The well-formed file reads.
+  CHECK(read_as(glb("0", "", "0", "4")).mesh.n_faces() == 4);
+  // 2^64 - 252 * 3 - 12: with stride 252 and 4 elements, start + 252 * 3 + 12 wraps to 0.
+  CHECK_THROWS_WITH(read_as(glb("0", "252", "18446744073709550848", "4")),
+                    Catch::Contains("accessor 0 reaches past the end of its bufferView"));
+  // 2^64 - 48: the accessor would start 48 bytes before the buffer.
+  CHECK_THROWS_WITH(read_as(glb("0", "", "18446744073709551568", "4")), Catch::Contains("reaches past the end"));
+  // A bufferView offset that wraps its end round to a small number.
+  CHECK_THROWS_WITH(read_as(glb("18446744073709551600", "", "0", "4")),
+                    Catch::Contains("bufferView 0 reaches past the end of its buffer"));
+  // One element too many, and an offset that leaves no room for one element.
+  CHECK_THROWS_WITH(read_as(glb("0", "", "0", "5")), Catch::Contains("reaches past the end"));
+  CHECK_THROWS_WITH(read_as(glb("0", "", "40", "1")), Catch::Contains("reaches past the end"));
+}
