@@ -238,6 +238,12 @@ void HttpServer::Impl::setup() {
   server.set_pre_routing_handler([this](const httplib::Request& req, httplib::Response& res) {
     t_request_start = std::chrono::steady_clock::now();
     t_problem = {};
+    // One byte range at most. cpp-httplib 0.11 builds the multipart answer to every range asked for
+    // in memory, overlapping or not: "bytes=0-,0-,..." (2 000 ranges in a 6 KB header) made a 2 GB
+    // answer of a 1 MB result. RFC 9110 14.2 lets a server ignore Range: a request for several gets
+    // the whole answer, a 200. (The request object is httplib's own, not const; only its parsed
+    // ranges change.)
+    if (req.ranges.size() > 1) const_cast<httplib::Request&>(req).ranges.clear();
     if (req.method == "OPTIONS" && !options.cors_origin.empty()) {
       res.status = 204;
       res.set_header("Access-Control-Allow-Methods", "GET, POST, DELETE, OPTIONS");
