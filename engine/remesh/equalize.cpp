@@ -304,7 +304,7 @@ std::vector<CrossingKey> crossing_keys(const TriMesh& mesh, const std::vector<st
 /// at every exit without another search. The last round returns after its untangling.
 std::size_t untangle_and_mend(TriMesh& mesh, const ReferenceSurface& reference, const Params& params,
                               std::vector<NeighbourCache>& caches, const CreaseGuard* creases, IterationStats& row,
-                              PhaseSeconds& phases) {
+                              PhaseSeconds& phases, std::stop_token stop) {
   // The row describes the mesh before the feature snap, which takes no edge out of the interval.
   const std::size_t outside_before = row.small + row.big;
   // The crossing pairs counted after a mend, for the next round's untangling (which would search
@@ -313,19 +313,20 @@ std::size_t untangle_and_mend(TriMesh& mesh, const ReferenceSurface& reference, 
   for (int round = 1;; ++round) {
     PhaseTimer timer(phases.untangle);
     const UntangleCounts u = untangle_creases_first(mesh, reference, params.e_min, params.e_max, params.threads,
-                                                    creases, std::exchange(crossing, std::nullopt));
+                                                    creases, std::exchange(crossing, std::nullopt), stop);
     row.cleanup_fixes += u.moved;
     // Its flips and collapses count with the row's own, as the cleanup's do (count_cleanup).
     row.flips += u.flipped;
     row.collapses += u.collapsed;
-    if (u.moved == 0 || round == kUntangleRounds) return u.left.size();
+    if (u.moved == 0 || round == kUntangleRounds || stop.stop_requested()) return u.left.size();
     // Nothing to mend when no more edges are outside than before (the vertex moves and flips
     // never take one out; a collapse may leave a short one, a flattened disk any).
     const IterationStats now = measure(mesh, params.e_min, params.e_max, params.threads);
     if (now.small + now.big <= outside_before) return u.left.size();
     const std::vector<CrossingKey> left = crossing_keys(mesh, u.left);
     timer.switch_to(phases.cleanup);
-    const CleanupCounts c = run_cleanup(mesh, reference, params, caches, creases, /*final=*/true);
+    const CleanupCounts c = run_cleanup(mesh, reference, params, caches, creases, /*final=*/true,
+                                        /*boundary_only=*/false, stop);
     timer.switch_to(phases.untangle);
     count_cleanup(row, c);
     // Again only if the cleanup made faces cross that did not before (the pairs it left alone
@@ -745,7 +746,8 @@ Result equalize(TriMesh& mesh, const Params& requested, const OnIteration& on_it
       timer.stop();
       const std::size_t fixes_before = row.cleanup_fixes;
       row.cleanup_fixes += snapped;
-      result.crossing_pairs = untangle_and_mend(mesh, *reference, params, neighbour_caches, guard.get(), row, phases);
+      result.crossing_pairs =
+          untangle_and_mend(mesh, *reference, params, neighbour_caches, guard.get(), row, phases, stop);
       if (row.cleanup_fixes != fixes_before) row = measured_row(mesh, params, row);
     }
     // The outcome of a run that stopped early describes the mesh returned, which this row does: the

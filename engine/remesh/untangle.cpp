@@ -34,6 +34,14 @@ constexpr double kSteps[] = {1.0, 0.5, 0.25};
 /// Rounds of flips and collapses at most (each round runs while the last lowered the crossings).
 /// Measured (crossing face pairs, armadillo coarsened): 6 after one round, 0 after two.
 constexpr int kEditRounds = 4;
+/// The untangling's budget: once its crossing tests have been given kWorkBase + kWorkPerFace
+/// faces per face of the mesh (Untangler::faces_near), it makes no more edits. Measured (Table
+/// 4.2 setup): the runs that untangle anything use at most 36 per face (cheese simplified: 74 876
+/// for 2 084 faces; cow refined 48 620 for 12 238). A crumpled input (eight.off with its vertices
+/// moved at random, remeshed at 0.05-0.08: 37 309 crossing pairs) used 29 000 per face and 221 s,
+/// and it left 18 325 pairs either way.
+constexpr std::size_t kWorkBase = std::size_t{1} << 20;
+constexpr std::size_t kWorkPerFace = 64;
 /// The largest disk a tangle is flattened in: its vertices within this many rings of the tangle's.
 constexpr std::size_t kMaxPatchRings = 4;
 /// Gauss-Seidel sweeps of the membrane at most, and the move (relative to the mean edge of the
@@ -143,8 +151,10 @@ class Untangler {
   std::size_t move_round(const Pairs& pairs) {
     if (!face_index_) index_faces();
     std::size_t kept = 0;
-    for (auto v : vertices_of(mesh_, pairs))
+    for (auto v : vertices_of(mesh_, pairs)) {
+      if (exhausted()) break;
       if (!mesh_.is_boundary(v) && !unchanged_since_failure(v) && try_moves(v)) ++kept;
+    }
     return kept;
   }
 
@@ -175,7 +185,7 @@ class Untangler {
     index_if_drifted();
     failures_.clear();  // a flattened disk moves its rim's neighbourhood at once: every vertex tries again
     for (const std::vector<VertexHandle>& seeds : tangles(mesh_, pairs)) {
-      for (std::size_t rings = 1; rings <= kMaxPatchRings; ++rings) {
+      for (std::size_t rings = 1; rings <= kMaxPatchRings && !exhausted(); ++rings) {
         const std::optional<Disk> disk = disk_around(seeds, rings);
         if (!disk) continue;
         if (flatten_disk(*disk)) {
@@ -193,8 +203,10 @@ class Untangler {
   std::size_t flip_round(const Pairs& pairs) {
     if (!face_index_) index_faces();
     std::size_t kept = 0;
-    for (auto e : edges_of(mesh_, pairs))
+    for (auto e : edges_of(mesh_, pairs)) {
+      if (exhausted()) break;
       if (try_flip(e)) ++kept;
+    }
     if (kept > 0) failures_.clear();  // the flipped quads changed their vertices' stars
     return kept;
   }
@@ -222,7 +234,18 @@ class Untangler {
       out.erase(std::remove_if(out.begin(), out.end(),
                                [&](std::uint32_t f) { return mesh_.status(mesh_.face_handle(f)).deleted(); }),
                 out.end());
+    work_ += out.size();
   }
+
+  /// Whether the untangling should make no more edits: `stop` is requested, or the faces its
+  /// crossing tests were given (faces_near) number more than the budget (see kWorkPerFace). Each
+  /// edit is whole, so the mesh is valid whenever the edits stop.
+  bool exhausted() const { return work_ > budget_ || stop_.stop_requested(); }
+  void set_limits(std::stop_token stop, std::size_t budget) {
+    stop_ = std::move(stop);
+    budget_ = budget;
+  }
+  std::size_t work() const { return work_; }
 
   /// Records a collapse just made, its from-vertex gone from `gone_at` into `stays` (which stays
   /// where it is): the faces of stays' star, which include every face whose corners it changed,
@@ -600,6 +623,9 @@ class Untangler {
   FaceSpheres spheres_;
   std::optional<PointIndex> face_index_;
   mutable std::vector<FaceSphere> star_;  ///< crossings()' scratch
+  mutable std::size_t work_ = 0;          ///< faces given to crossing tests (faces_near)
+  std::size_t budget_ = SIZE_MAX;         ///< exhausted() past this much work
+  std::stop_token stop_;
   std::vector<std::uint32_t> near_;       ///< try_moves()' scratch
   /// The position at index_faces() of each vertex moved since (a vertex a flattened disk moved
   /// first: where the disk left it; its faces are reshaped), and the farthest any has moved.
@@ -728,6 +754,7 @@ std::size_t collapse_round(TriMesh& mesh, Untangler& untangler, double e_max, co
   CollapseJudge judge(mesh, untangler);
   std::size_t kept = 0;
   for (auto e : edges_of(mesh, pairs)) {
+    if (untangler.exhausted()) break;
     if (mesh.status(e).deleted()) continue;
     const HalfedgeHandle h0 = mesh.halfedge_handle(e, 0);
     const VertexHandle a = mesh.from_vertex_handle(h0), b = mesh.to_vertex_handle(h0);
@@ -755,13 +782,17 @@ std::size_t collapse_round(TriMesh& mesh, Untangler& untangler, double e_max, co
 
 }  // namespace
 
+std::size_t untangle_budget(std::size_t faces) { return kWorkBase + kWorkPerFace * faces; }
+
 UntangleCounts untangle(TriMesh& mesh, const ReferenceSurface& reference, double e_min, double e_max,
-                        unsigned threads, const CreaseGuard* creases, std::optional<Pairs> crossing) {
+                        unsigned threads, const CreaseGuard* creases, std::optional<Pairs> crossing,
+                        std::stop_token stop) {
   UntangleCounts counts;
   Pairs pairs = crossing ? std::move(*crossing) : find_self_intersections(mesh, threads);
   counts.pairs_before = pairs.size();
   if (pairs.empty()) return counts;
   Untangler untangler(mesh, reference, e_min, e_max, creases);
+  untangler.set_limits(stop, untangle_budget(mesh.n_faces()));
   auto move_rounds = [&] {
     for (int r = 0; r < kMoveRounds && !pairs.empty(); ++r) {
       const std::size_t kept = untangler.move_round(pairs);
@@ -814,20 +845,24 @@ UntangleCounts untangle(TriMesh& mesh, const ReferenceSurface& reference, double
     std::sort(pairs.begin(), pairs.end());
   }
   counts.left = std::move(pairs);
+  counts.work = untangler.work();
+  counts.cut_short = untangler.exhausted();
   return counts;
 }
 
 UntangleCounts untangle_creases_first(TriMesh& mesh, const ReferenceSurface& reference, double e_min,
                                       double e_max, unsigned threads, const CreaseGuard* creases,
-                                      std::optional<Pairs> crossing) {
-  UntangleCounts first = untangle(mesh, reference, e_min, e_max, threads, creases, std::move(crossing));
+                                      std::optional<Pairs> crossing, std::stop_token stop) {
+  UntangleCounts first = untangle(mesh, reference, e_min, e_max, threads, creases, std::move(crossing), stop);
   if (!creases || first.left.empty()) return first;
-  UntangleCounts rest = untangle(mesh, reference, e_min, e_max, threads);
+  UntangleCounts rest = untangle(mesh, reference, e_min, e_max, threads, nullptr, std::nullopt, stop);
   rest.pairs_before = first.pairs_before;
   rest.moved += first.moved;
   rest.flipped += first.flipped;
   rest.collapsed += first.collapsed;
   rest.flattened += first.flattened;
+  rest.work += first.work;
+  rest.cut_short = rest.cut_short || first.cut_short;
   return rest;
 }
 

@@ -33,6 +33,7 @@
 
 #include <cstddef>
 #include <optional>
+#include <stop_token>
 #include <utility>
 #include <vector>
 
@@ -50,7 +51,16 @@ struct UntangleCounts {
   std::size_t flipped = 0;    ///< of them, flips
   std::size_t collapsed = 0;  ///< collapses
   std::size_t flattened = 0;  ///< of them, vertices of flattened disks
+  /// Faces given to its crossing tests; past untangle_budget() of the mesh's faces it stops.
+  std::size_t work = 0;
+  /// Stopped before it was done: by its budget, or because the stop token was triggered.
+  bool cut_short = false;
 };
+
+/// The work (faces given to crossing tests) after which untangle() makes no more edits on a mesh
+/// of `faces` faces: a crumpled input can hold tens of thousands of crossing pairs, whose
+/// untangling took minutes (untangle.cpp, kWorkPerFace). Every edit is whole: the mesh stays valid.
+std::size_t untangle_budget(std::size_t faces);
 
 /// Moves the vertices of crossing faces of `mesh` apart, flips and collapses their edges (see the
 /// file comment). The mesh stays valid, without deleted elements, and the topology and the boundary
@@ -64,9 +74,11 @@ struct UntangleCounts {
 /// ends, CreaseGuard::along(a, b), whatever the angle of its faces: a tangle may crumple them flat.)
 /// `crossing`, when given, are the mesh's crossing face pairs as find_self_intersections() gives
 /// them now (a caller that has just counted them): the search that starts the step is skipped.
+/// A stop request ends it between two edits (UntangleCounts::cut_short), as does its budget.
 UntangleCounts untangle(TriMesh& mesh, const ReferenceSurface& reference, double e_min, double e_max,
                         unsigned threads, const CreaseGuard* creases = nullptr,
-                        std::optional<std::vector<std::pair<unsigned, unsigned>>> crossing = std::nullopt);
+                        std::optional<std::vector<std::pair<unsigned, unsigned>>> crossing = std::nullopt,
+                        std::stop_token stop = {});
 
 /// untangle() with the crease guard, then, for the crossings that leaves, untangle() without it:
 /// a crossing is worse than a crease vertex moved (equalize's last step with Params::keep_creases).
@@ -78,6 +90,7 @@ UntangleCounts untangle(TriMesh& mesh, const ReferenceSurface& reference, double
 /// `crossing` as for untangle().
 UntangleCounts untangle_creases_first(TriMesh& mesh, const ReferenceSurface& reference, double e_min,
                                       double e_max, unsigned threads, const CreaseGuard* creases,
-                                      std::optional<std::vector<std::pair<unsigned, unsigned>>> crossing = std::nullopt);
+                                      std::optional<std::vector<std::pair<unsigned, unsigned>>> crossing = std::nullopt,
+                                      std::stop_token stop = {});
 
 }  // namespace remesh

@@ -7,7 +7,9 @@
 #include <array>
 #include <cmath>
 #include <map>
+#include <optional>
 #include <random>
+#include <stop_token>
 #include <utility>
 #include <vector>
 
@@ -617,4 +619,47 @@ TEST_CASE("untangle with the crease guard leaves a box's edges where they are", 
   CHECK(cut_without > 0);                          // the guard is what keeps the edge
   CHECK(4 * crossings_after < 3 * crossings_before);  // and it still untangles (about half of them)
   CHECK(crossings_after_both < crossings_after_guard);  // the free pass mends more of what is left
+}
+
+TEST_CASE("untangle stops between edits when asked, and within its budget on a mesh crumpled all over",
+          "[untangle]") {
+  const TriMesh reference = test::make_hex_lattice_patch(20, 20, 1.5);
+  const ReferenceSurface surface(reference);
+  // A patch crumpled as above: with the stop asked for before it starts, nothing moves.
+  TriMesh patch = crumpled(reference, {Vec3(15, 13, 0)}, 3, 2);
+  const Pairs before = find_self_intersections(patch, 1);
+  REQUIRE_FALSE(before.empty());
+  const TriMesh given = patch;
+  std::stop_source stop;
+  stop.request_stop();
+  const UntangleCounts stopped = untangle(patch, surface, 1.2, 1.8, 1, nullptr, std::nullopt, stop.get_token());
+  CHECK(stopped.cut_short);
+  CHECK(stopped.moved == 0);
+  CHECK(stopped.left == before);
+  CHECK(sorted_points(patch) == sorted_points(given));
+  // Not asked, the same patch is untangled within its budget.
+  const UntangleCounts done = untangle(patch, surface, 1.2, 1.8, 1);
+  CHECK_FALSE(done.cut_short);
+  CHECK(done.left.empty());
+  CHECK(done.work <= untangle_budget(patch.n_faces()));
+  // Every vertex of a larger lattice moved by up to two edges across and up: thousands of crossing
+  // pairs, more than the budget lets it mend. It stops there, with the mesh whole: every face
+  // valid, the pairs it reports left the ones there are.
+  const TriMesh wide = test::make_hex_lattice_patch(40, 40, 1.5);
+  const ReferenceSurface wide_surface(wide);
+  TriMesh mesh = wide;
+  std::mt19937 rng(5);
+  jitter(mesh, 3.0, rng);
+  const std::size_t tangled = find_self_intersections(mesh, 1).size();
+  CAPTURE(tangled);
+  REQUIRE(tangled > 1000);
+  const UntangleCounts counts = untangle(mesh, wide_surface, 1.2, 1.8, 1);
+  CHECK(counts.cut_short);
+  // The edit under way when the budget ran out finishes: past it by at most one edit's tests (a
+  // vertex move's candidates, each against the faces near it), far below the work it would take.
+  CHECK(counts.work > untangle_budget(mesh.n_faces()));
+  CHECK(counts.work < 2 * untangle_budget(mesh.n_faces()));
+  CHECK(mesh.n_vertices() > 0);
+  CHECK(counts.left == find_self_intersections(mesh, 1));
+  CHECK(counts.left.size() < tangled);
 }
