@@ -779,7 +779,9 @@ Result equalize(TriMesh& mesh, const Params& requested, const OnIteration& on_it
   mesh.request_vertex_normals();
   mesh.request_face_normals();
   mesh.update_normals();
-  result.thin = thin_parts(mesh, *reference, params.e_min, params.e_max, threads);
+  // Measured for the result only: a cancelled run has none (and its caller is waiting).
+  if (result.outcome != Outcome::Cancelled)
+    result.thin = thin_parts(mesh, *reference, params.e_min, params.e_max, threads);
   // A run without the untangling (cleanup off, or stopped before it) counts them here; a cancelled
   // one leaves them unknown.
   if (!result.crossing_pairs && result.outcome != Outcome::Cancelled)

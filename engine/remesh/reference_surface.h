@@ -58,7 +58,10 @@ class ReferenceSurface {
 
   /// Distance from p to the nearest reference triangle that faces against `normal` (a unit vector;
   /// the triangle's unit normal n with n . normal < -0.3): the other side of the part p lies on.
-  /// Only triangles nearer than `limit` are looked at; infinity when there is none.
+  /// Only triangles nearer than `limit` are looked at; infinity when there is none. The search
+  /// visits at most 16 384 reference vertices and long triangles, nearest first roughly (the
+  /// Table 4.2 inputs need under 2 000); on a reference whose long triangles span most of it, it
+  /// stops there with the nearest found so far.
   double opposite_side_distance(const Vec3& p, const Vec3& normal, double limit) const;
   /// Whether opposite_side_distance(p, normal, limit) < limit: the same test, stopped at the
   /// first such triangle.
