@@ -24,6 +24,9 @@ void require_input_file(const std::string& path);
 /// The format to write `path` in, from its extension. Throws UsageError for an unknown extension
 /// and for .gltf (only the binary .glb is written), and when the directory of `path` does not exist.
 Format require_output_format(const std::string& path);
+/// Throws UsageError unless a file can be written at `path`: its directory exists and takes a new
+/// file, and `path` is no directory.
+void require_writable(const std::string& path);
 /// The prologue of commands that read IN and write OUT: checks IN exists and OUT's format and
 /// directory before reading (so no work is wasted on a bad OUT), then reads IN.
 LoadedMesh read_input_for(const std::string& in, const std::string& out, bool weld);

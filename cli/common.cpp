@@ -29,6 +29,11 @@ Format require_output_format(const std::string& path) {
   if (*format == Format::Gltf)
     throw UsageError("writing text glTF is not supported: name the output .glb (binary glTF) instead of '" +
                      path + "'");
+  require_writable(path);
+  return *format;
+}
+
+void require_writable(const std::string& path) {
   // Checked now, not after a long run: the directory the output goes to must exist.
   const auto dir = std::filesystem::path(path).parent_path();
   std::error_code ec;
@@ -46,7 +51,6 @@ Format require_output_format(const std::string& path) {
     throw UsageError("cannot write to the output directory " + (dir.empty() ? std::string(".") : dir.string()) +
                      ": " + std::strerror(error));
   }
-  return *format;
 }
 
 void print_repairs(std::ostream& out, const std::vector<Repair>& repairs) {

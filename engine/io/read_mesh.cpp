@@ -19,6 +19,11 @@ LoadedMesh read_mesh(std::string_view bytes, const ReadOptions& options) {
     if (sniffed == Format::Gltf || sniffed == Format::Glb) format = sniffed;
   }
   if (!format) throw MeshError("unrecognised mesh format (supported: OBJ, OFF, PLY, STL, glTF, GLB)");
+  // A UTF-8 byte order mark before a text header (editors on Windows write one): detect_format
+  // passes over it, and so do the readers now. (The OBJ reader took "\xEF\xBB\xBFv" for an unknown
+  // line and dropped the first vertex; PLY and ASCII STL refused the file.) STL sees to its own:
+  // a binary STL's 80-byte header may start with any bytes.
+  if (bytes.starts_with("\xEF\xBB\xBF") && *format != Format::Stl && *format != Format::Glb) bytes.remove_prefix(3);
   io::RawSoup soup;
   switch (*format) {
     case Format::Obj: soup = io::read_obj(bytes, options); break;

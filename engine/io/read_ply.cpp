@@ -3,6 +3,7 @@
 /// element's x/y/z (any numeric type) and the face element's index list (any count/index types)
 /// are kept, everything else is skipped.
 
+#include <cstdio>
 #include <string>
 #include <vector>
 
@@ -239,10 +240,18 @@ class BodyReader {
 
 bool is_integer(double v, double limit) { return v >= -limit && v <= limit && v == std::floor(v); }
 
+/// A number read from the file, for a message: %g, not std::to_string's fixed notation (an index of
+/// 1e300 came out as 301 digits).
+std::string number_text(double v) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.9g", v);
+  return text;
+}
+
 std::int64_t as_count(double v, std::size_t max_items, const Where& where, BodyReader& body) {
   if (!is_integer(v, 1e15) || v < 0 || v > static_cast<double>(max_items))
     fail("PLY" + (body.ascii() ? " line " + std::to_string(body.line()) : std::string()) + ": bad list length " +
-         std::to_string(v) + " in " + where.str() + " (negative, fractional or past the end of the file)");
+         number_text(v) + " in " + where.str() + " (negative, fractional or past the end of the file)");
   return static_cast<std::int64_t>(v);
 }
 
@@ -293,7 +302,7 @@ RawSoup read_ply(std::string_view bytes, const ReadOptions& options) {
           double v = body.scalar(pr.type, what);
           if (!keep) continue;
           if (!is_integer(v, 1e15))
-            fail("PLY: face " + std::to_string(i) + " has a non-integer vertex index " + std::to_string(v));
+            fail("PLY: face " + std::to_string(i) + " has a non-integer vertex index " + number_text(v));
           soup.indices.push_back(static_cast<std::int64_t>(v));
         }
         if (keep) soup.offsets.push_back(static_cast<std::uint32_t>(soup.indices.size()));

@@ -131,8 +131,12 @@ RawSoup read_stl(std::string_view bytes, const ReadOptions& options) {
     if (84 + 50 * n == bytes.size()) return read_binary_stl(bytes, options);
   }
   std::string_view text = bytes;
+  if (text.starts_with("\xEF\xBB\xBF")) text.remove_prefix(3);  // a UTF-8 byte order mark
   while (!text.empty() && (is_space(text[0]) || text[0] == '\n')) text.remove_prefix(1);
-  if (text.substr(0, 5) == "solid") return read_ascii_stl(bytes, options);
+  // ASCII STL holds no NUL byte; a binary one whose header starts with "solid" (many exporters
+  // write one) almost always does, in its counts and coordinates: a truncated binary file is then
+  // reported as binary, with its size, not as ASCII without 'endsolid'.
+  if (text.substr(0, 5) == "solid" && bytes.find('\0') == std::string_view::npos) return read_ascii_stl(text, options);
   return read_binary_stl(bytes, options);
 }
 

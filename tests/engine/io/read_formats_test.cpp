@@ -308,3 +308,56 @@ TEST_CASE("GLB: accessor and bufferView offsets whose sums wrap round 2^64 are r
   CHECK_THROWS_WITH(read_as(glb("0", "", "0", "5")), Catch::Contains("reaches past the end"));
   CHECK_THROWS_WITH(read_as(glb("0", "", "40", "1")), Catch::Contains("reaches past the end"));
 }
+
+TEST_CASE("A UTF-8 byte order mark before a text format is passed over: the same mesh as without it") {
+  const std::string bom = "\xEF\xBB\xBF";
+  const std::string obj = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n";
+  const std::string off = "OFF\n4 4 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n";
+  const std::string ply = "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\n"
+                          "property float z\nelement face 4\nproperty list uchar int vertex_indices\nend_header\n"
+                          "0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n";
+  std::string stl = "solid tet\n";
+  const char* facets[4][3] = {{"0 0 0", "0 1 0", "1 0 0"}, {"0 0 0", "1 0 0", "0 0 1"},
+                              {"0 0 0", "0 0 1", "0 1 0"}, {"1 0 0", "0 1 0", "0 0 1"}};
+  for (const auto& f : facets)
+    stl += std::string("facet normal 0 0 0\nouter loop\nvertex ") + f[0] + "\nvertex " + f[1] + "\nvertex " + f[2] +
+           "\nendloop\nendfacet\n";
+  stl += "endsolid tet\n";
+  for (const std::string& text : {obj, off, ply, stl}) {
+    CAPTURE(text.substr(0, 12));
+    const LoadedMesh plain = read_as(text);
+    const LoadedMesh marked = read_as(bom + text);
+    CHECK(plain.mesh.n_vertices() == 4);
+    CHECK(plain.mesh.n_faces() == 4);
+    CHECK(marked.format == plain.format);
+    CHECK(marked.mesh.n_vertices() == plain.mesh.n_vertices());
+    CHECK(marked.mesh.n_faces() == plain.mesh.n_faces());
+    for (auto v : plain.mesh.vertices()) CHECK(marked.mesh.point(v) == plain.mesh.point(v));
+    // Given its format by name too (the OBJ reader took the marked first line for an unknown one).
+    CHECK(read_as(bom + text, plain.format).mesh.n_faces() == 4);
+  }
+}
+
+TEST_CASE("Read errors name the file's real kind and print numbers short") {
+  // A binary STL whose header starts with "solid" (many exporters write one), cut short: reported
+  // as binary, with its sizes, not as an ASCII file without 'endsolid'.
+  std::string stl = "solid exported by a binary writer";
+  stl.resize(80, ' ');
+  const std::uint32_t n = 12;
+  stl.append(reinterpret_cast<const char*>(&n), 4);
+  stl.append(50 * 5, '\0');
+  CHECK_THROWS_WITH(read_as(stl), Catch::Contains("binary STL") && Catch::Contains("12 triangles"));
+  // A PLY vertex index of 1e300: the message says 1e+300, not 301 digits.
+  const std::string ply = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+                          "property float z\nelement face 1\nproperty list uchar double vertex_indices\nend_header\n"
+                          "0 0 0\n1 0 0\n0 1 0\n3 0 1 1e300\n";
+  try {
+    read_as(ply);
+    FAIL("read");
+  } catch (const std::exception& e) {
+    const std::string message = e.what();
+    CAPTURE(message);
+    CHECK(message.size() < 200);
+    CHECK(message.find("1e+300") != std::string::npos);
+  }
+}
