@@ -1,5 +1,6 @@
 #include "log.h"
 
+#include <algorithm>
 #include <cstdio>
 
 #include <nlohmann/json.hpp>
@@ -24,7 +25,11 @@ void Logger::log(const char* level, const std::string& event, const std::vector<
   } else {
     line = ts + " " + level + " " + event;
     for (const LogField& f : fields) {
-      bool quote = f.value.empty() || f.value.find_first_of(" \"=\t\n") != std::string::npos;
+      // Quoted (JSON string escapes) when it has a space, a quote, '=' or any control byte: a raw
+      // carriage return or NUL from a request path made a line that looked like two, or like binary.
+      bool quote = f.value.empty() || std::any_of(f.value.begin(), f.value.end(), [](char c) {
+                     return static_cast<unsigned char>(c) < 0x20 || c == 0x7f || c == ' ' || c == '"' || c == '=';
+                   });
       line += " " + f.key + "=" + (quote ? nlohmann::json(f.value).dump(-1, ' ', false, nlohmann::json::error_handler_t::replace) : f.value);
     }
   }

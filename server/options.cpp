@@ -55,8 +55,13 @@ const std::vector<Spec>& specs() {
       {"data-dir", "DIR",
        "job storage (default $XDG_STATE_HOME/remeshd, else ~/.local/state/remeshd, else ./remeshd-data)",
        [](Options& o, const std::string& v) { o.data_dir = v; }},
-      {"max-upload-mb", "N", "largest upload in MiB (default 256)",
-       [](Options& o, const std::string& v) { o.max_upload_mb = to_size("max-upload-mb", v); }},
+      {"max-upload-mb", "N", "largest upload in MiB (default 256; 1 to 1048576)",
+       [](Options& o, const std::string& v) {
+         // In bytes it must fit the byte counts: 2^44 MiB wrapped round to a limit of 0.
+         o.max_upload_mb = to_size("max-upload-mb", v);
+         if (o.max_upload_mb < 1 || o.max_upload_mb > 1'048'576)
+           throw std::invalid_argument("--max-upload-mb: " + v + " is not 1 to 1048576 (MiB)");
+       }},
       {"max-faces", "N", "largest input mesh in faces (default 2000000)",
        [](Options& o, const std::string& v) { o.max_faces = to_size("max-faces", v); }},
       {"max-output-faces", "N", "largest estimated result in faces (default 5000000)",
@@ -72,7 +77,11 @@ const std::vector<Spec>& specs() {
       {"job-ttl-hours", "H", "finished jobs are deleted after H hours (default 168; 0 = never)",
        [](Options& o, const std::string& v) { o.job_ttl_hours = to_double("job-ttl-hours", v); }},
       {"data-cap-mb", "N", "size cap of the data directory in MiB, oldest finished jobs go first (default 10240; 0 = none)",
-       [](Options& o, const std::string& v) { o.data_cap_mb = to_size("data-cap-mb", v); }},
+       [](Options& o, const std::string& v) {
+         o.data_cap_mb = to_size("data-cap-mb", v);
+         if (o.data_cap_mb > (std::size_t{1} << 40))
+           throw std::invalid_argument("--data-cap-mb: " + v + " is past 2^40 MiB (0 = no cap)");
+       }},
       {"token", "T", "require 'Authorization: Bearer T' on every /api route (default: none)",
        [](Options& o, const std::string& v) { o.token = v; }},
       {"cors-origin", "O", "allow cross-origin requests from O ('*' = any; default: CORS off)",

@@ -161,6 +161,19 @@ TEST_CASE("remeshd: upload limits are enforced while reading", "[server][limits]
   CHECK(multi->status == 413);
   CHECK(count_files(tmp.path / "data" / "jobs") == 0);
 
+  // A declared length far over the limit (past what is drained), or not a byte count, is answered
+  // at once, before any body (none follows here): it waited for the body until the 30-second read
+  // timeout.
+  for (const auto& [length, status] : {std::pair{"9999999999", "413"}, std::pair{"99999999999999999999999", "413"},
+                                       std::pair{"-5", "400"}, std::pair{"12abc", "400"}}) {
+    CAPTURE(length);
+    const std::string answer =
+        raw_exchange(d.port(), std::string("POST /api/v1/jobs?emin=0.2&emax=0.35 HTTP/1.1\r\nHost: x\r\n") +
+                                   "Content-Length: " + length + "\r\n\r\n",
+                     10.0);
+    CHECK(answer.starts_with(std::string("HTTP/1.1 ") + status));
+    CHECK(answer.find("application/problem+json") != std::string::npos);
+  }
   // The server is fine afterwards, and an upload under the limit passes.
   auto ok = submit_raw(c, mesh, "emin=0.2&emax=0.35&iterations=2");
   REQUIRE(ok);

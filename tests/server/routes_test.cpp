@@ -7,6 +7,7 @@
 #include <iterator>
 #include <regex>
 #include <set>
+#include <sstream>
 
 #include "api/json_codec.h"
 #include "daemon.h"
@@ -482,6 +483,22 @@ TEST_CASE("remeshd: parameters and names that once crashed the service or gave 5
           std::string::npos);
   }
   CHECK(size > 0);
+  // Control bytes in a request path are escaped in the log: a raw carriage return made a line that
+  // looked like two, a NUL made the log look binary. Every line is one event, starting with its time.
+  for (const char* path : {"/api/v1/jobs/abc%0dFAKE-LINE", "/api/v1/jobs/%00", "/api/v1/jobs/a%1b[31mred"})
+    CHECK(c.Get(path)->status == 404);
+  {
+    const std::string log = d.log();
+    CHECK(log.find('\r') == std::string::npos);
+    CHECK(log.find('\0') == std::string::npos);
+    CHECK(log.find('\x1b') == std::string::npos);
+    CHECK(log.find("abc\\rFAKE-LINE") != std::string::npos);
+    std::istringstream lines(log);
+    for (std::string line; std::getline(lines, line);) {
+      CAPTURE(line);
+      CHECK(line.starts_with("20"));
+    }
+  }
   // Several ranges get the whole answer once (200), not one part per range: 2 000 copies of a
   // result in one answer made a 6 KB request a 2 GB answer held in memory.
   std::string many = "bytes=0-";

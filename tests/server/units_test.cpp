@@ -76,7 +76,11 @@ TEST_CASE("options: defaults, command line, environment, errors", "[server][opti
                                                          {"--max-iterations", "0"},
                                                          {"--heartbeat-seconds", "1e10"},
                                                          {"--heartbeat-seconds", "nan"},
-                                                         {"--stream-lifetime-seconds", "1e12"}}) {
+                                                         {"--stream-lifetime-seconds", "1e12"},
+                                                         // MiB counts whose bytes wrap round 2^64
+                                                         {"--max-upload-mb", "17592186044416"},
+                                                         {"--max-upload-mb", "0"},
+                                                         {"--data-cap-mb", "17592186044416"}}) {
     auto r = Args(bad).parse();
     CHECK_FALSE(r.options);
     CHECK(r.exit_code == 2);
