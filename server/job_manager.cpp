@@ -5,9 +5,15 @@
 #endif
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
+#include <condition_variable>
+#include <mutex>
+#include <stop_token>
+#include <thread>
 #include <utility>
 
+#include "api/json_codec.h"
 #include "job_runner.h"
 
 namespace remeshd {
@@ -261,8 +267,35 @@ void JobManager::run(const std::string& id) {
       changed_.notify_all();
     };
     auto write = [&](const std::string& name, std::string_view bytes) { store_.write_file(id, name, bytes); };
+    // The time limit: a watchdog stops the run through the job's own stop source (the engine
+    // checks it between phases and within its long steps), unless the run ends first.
+    std::atomic<bool> timed_out{false};
+    std::jthread watchdog;
+    if (config_.max_job_seconds > 0)
+      watchdog = std::jthread([&timed_out, job, limit = config_.max_job_seconds](std::stop_token ended) {
+        std::mutex m;
+        std::condition_variable_any cv;
+        std::unique_lock lock(m);
+        cv.wait_for(lock, ended, secs(limit), [] { return false; });
+        if (!ended.stop_requested() && !job->stop.stop_requested()) {
+          timed_out = true;
+          job->stop.request_stop();
+        }
+      });
     RunOutput out = run_job(record, std::move(upload), config_.engine_threads, on_iteration, token, write);
+    watchdog = std::jthread();  // stopped and joined: timed_out is final
     const remesh::Result& result = out.result;
+    if (result.outcome == remesh::Outcome::Cancelled && timed_out) {
+      {
+        std::lock_guard lock(mutex_);
+        job->record.error = "the run took longer than the service's limit of " +
+                            remesh::format_double(config_.max_job_seconds) +
+                            " s (remeshd --max-job-seconds) and was stopped";
+      }
+      log_.warn("job", {str("job", id), str("stopped", "time limit")});
+      finish(JobState::Failed);
+      return;
+    }
     if (result.outcome == remesh::Outcome::Cancelled) {
       {
         std::lock_guard lock(mutex_);

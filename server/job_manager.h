@@ -39,6 +39,9 @@ struct ManagerConfig {
   double job_ttl_seconds = 0;      ///< 0 = never expire
   std::uint64_t data_cap_bytes = 0;  ///< 0 = no cap
   unsigned engine_threads = 0;     ///< threads per job
+  /// A run still going after this many seconds is stopped and the job fails, saying so (0 = no
+  /// limit): a valid input can still take hours (a fan of a million spokes round one vertex).
+  double max_job_seconds = 0;
 };
 
 class JobManager {

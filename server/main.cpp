@@ -50,6 +50,7 @@ int main(int argc, char** argv) {
     mc.workers = o.workers ? o.workers : cores;
     mc.queue_size = o.queue_size;
     mc.job_ttl_seconds = o.job_ttl_hours * 3600.0;
+    mc.max_job_seconds = o.max_job_seconds;
     mc.data_cap_bytes = static_cast<std::uint64_t>(o.data_cap_mb) * 1024 * 1024;
     mc.engine_threads = std::max(1u, cores / mc.workers);
 

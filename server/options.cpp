@@ -72,6 +72,12 @@ const std::vector<Spec>& specs() {
          if (n < 1 || n > 1'000'000) throw std::invalid_argument("--max-iterations: must be 1..1000000");
          o.max_iterations = static_cast<int>(n);
        }},
+      {"max-job-seconds", "S", "a run still going after S seconds is stopped and its job fails (default 3600; 0 = no limit)",
+       [](Options& o, const std::string& v) {
+         o.max_job_seconds = to_double("max-job-seconds", v);
+         if (!(o.max_job_seconds >= 0 && o.max_job_seconds <= 1e7))
+           throw std::invalid_argument("--max-job-seconds: " + v + " is not 0 to 10000000");
+       }},
       {"queue-size", "N", "queued jobs accepted before 503 (default 64)",
        [](Options& o, const std::string& v) { o.queue_size = to_size("queue-size", v); }},
       {"job-ttl-hours", "H", "finished jobs are deleted after H hours (default 168; 0 = never)",

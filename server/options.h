@@ -21,6 +21,7 @@ struct Options {
   std::size_t queue_size = 64;        ///< queued (not yet running) jobs before 503
   double job_ttl_hours = 168;         ///< finished jobs are removed after this; 0 = never
   std::size_t data_cap_mb = 10240;    ///< size cap of the data directory, MiB; 0 = none
+  double max_job_seconds = 3600;      ///< a run is stopped (the job fails) after this long; 0 = none
   std::string token;                  ///< "" = no authentication
   std::string cors_origin;            ///< "" = CORS off; "*" or an origin
   std::string log_format = "text";    ///< text | json

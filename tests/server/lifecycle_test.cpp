@@ -417,3 +417,21 @@ TEST_CASE("remeshd: the data cap removes the oldest finished jobs first, keeps t
   CHECK(list["jobs"][0]["id"] == second);
   CHECK(c.Get(("/api/v1/jobs/" + second + "/result?mesh=dual&format=obj").c_str())->status == 200);
 }
+
+TEST_CASE("remeshd: a run past --max-job-seconds is stopped and its job fails, saying why", "[server][limits]") {
+  TempDir tmp;
+  Daemon d(tmp.path / "data", {"--workers", "1", "--max-job-seconds", "1"});
+  auto c = d.client();
+  // kLong runs 400 iterations of a fine sphere: far more than a second.
+  const std::string slow = submit(c, sphere_obj(4), kLong);
+  const json ended = wait_final(c, slow);
+  CHECK(ended["state"] == "failed");
+  const std::string error = ended.value("error", "");
+  CAPTURE(error);
+  CHECK(error.find("--max-job-seconds") != std::string::npos);
+  CHECK(ended["progress"]["iteration"].get<int>() < 400);
+  // The worker is free again, and a job within the limit succeeds.
+  const std::string quick = submit(c, sphere_obj(2), kShort);
+  CHECK(wait_final(c, quick)["state"] == "succeeded");
+  CHECK(c.Get("/healthz")->status == 200);
+}
