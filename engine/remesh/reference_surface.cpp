@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <mutex>
 #include <utility>
 #include <vector>
 
@@ -71,17 +72,22 @@ struct ReferenceSurface::Impl {
   };
   std::vector<Star> stars;
   /// Per vertex: a cone around its triangles' unit normals (unit axis, cosine and sine of the
-  /// half-angle; a half-angle of pi when the normals have no common direction), for
-  /// opposite_side's test of a whole vertex (with the early stop: thin_parts.h's figures).
+  /// half-angle, widened by kConeMargin; a half-angle of pi when the normals have no common
+  /// direction), for opposite_side's test of a whole vertex (with the early stop: thin_parts.h's
+  /// figures). Floats, built on the first query (build_cones): 20 bytes a vertex, and only for the
+  /// surfaces whose thickness is asked (the input; not the feature snap's copies of the mesh).
   struct Cone {
-    Vec3 axis{0, 0, 0};
-    double cos_half = -1, sin_half = 0;
+    float axis[3] = {0, 0, 0};
+    float cos_half = -1, sin_half = 0;
   };
-  std::vector<Cone> cones;
+  static constexpr double kConeMargin = 1e-5;  ///< covers the floats' rounding (about 1e-7)
+  mutable std::vector<Cone> cones;
+  mutable std::once_flag cones_built;
+  void build_cones() const;
   /// opposite_side_distance's search: the vertices within limit + search_reach of the query find
   /// every triangle whose longest edge is at most search_reach (a point of a triangle lies within
   /// its longest edge of each corner); the longer triangles, a hundredth of them, are in
-  /// long_triangles and looked at one by one. An uneven input has a few very long edges (cheese:
+  /// long_triangles (and long_tree). An uneven input has a few very long edges (cheese:
   /// median 0.64, longest 9.5, scaled for the simplification): a search radius of the longest
   /// edge took in much of the mesh, 760 000 instructions a query.
   double search_reach = 0;
@@ -270,28 +276,6 @@ ReferenceSurface::ReferenceSurface(const TriMesh& mesh, std::size_t neighbours)
       for (auto c : m.triangles[*t].corners) r2 = std::max(r2, (m.points[c] - star.centre).sqrnorm());
     star.radius = std::sqrt(r2) * (1 + 1e-9) + 1e-12;  // a margin against rounding
   }
-  m.cones.resize(nv);
-  for (std::size_t v = 0; v < nv; ++v) {
-    Vec3 sum(0, 0, 0);
-    for (std::uint32_t j = m.vertex_triangles.offsets[v]; j < m.vertex_triangles.offsets[v + 1]; ++j)
-      sum += m.triangles[m.vertex_triangles.items[j]].normal;
-    const double len = sum.norm();
-    if (!(len > 1e-9)) continue;  // the whole sphere of directions
-    Impl::Cone& cone = m.cones[v];
-    cone.axis = sum / len;
-    double c = 1;
-    for (std::uint32_t j = m.vertex_triangles.offsets[v]; j < m.vertex_triangles.offsets[v + 1]; ++j) {
-      const Vec3& n = m.triangles[m.vertex_triangles.items[j]].normal;
-      if (n.sqrnorm() > 0) c = std::min(c, n | cone.axis);
-    }
-    c -= 1e-9;  // a margin against rounding
-    if (c <= -1) {
-      cone = Impl::Cone{};
-      continue;
-    }
-    cone.cos_half = c;
-    cone.sin_half = std::sqrt(std::max(0.0, 1.0 - c * c));
-  }
   // A triangle whose normal is nearly opposite to that of a larger neighbour across an edge lies
   // folded back onto it: a defect of the input (nefertiti has 96 such pairs: slivers that close
   // T-junctions of its base with their third corner on the wrong side). Its normal is noise, and a
@@ -354,6 +338,31 @@ std::size_t ReferenceSurface::n_vertices() const { return impl_->points.size(); 
 std::size_t ReferenceSurface::n_triangles() const { return impl_->triangles.size(); }
 bool ReferenceSurface::has_boundary() const { return impl_->boundary_edges > 0; }
 
+void ReferenceSurface::Impl::build_cones() const {
+  const std::size_t nv = points.size();
+  cones.assign(nv, Cone{});
+  for (std::size_t v = 0; v < nv; ++v) {
+    Vec3 sum(0, 0, 0);
+    for (std::uint32_t j = vertex_triangles.offsets[v]; j < vertex_triangles.offsets[v + 1]; ++j)
+      sum += triangles[vertex_triangles.items[j]].normal;
+    const double len = sum.norm();
+    if (!(len > 1e-9)) continue;  // the whole sphere of directions
+    const Vec3 axis = sum / len;
+    double c = 1;
+    for (std::uint32_t j = vertex_triangles.offsets[v]; j < vertex_triangles.offsets[v + 1]; ++j) {
+      const Vec3& n = triangles[vertex_triangles.items[j]].normal;
+      if (n.sqrnorm() > 0) c = std::min(c, n | axis);
+    }
+    c -= kConeMargin;  // wider: the test may read the float axis a little off
+    if (c <= -1) continue;
+    Cone& cone = cones[v];
+    for (int k = 0; k < 3; ++k) cone.axis[k] = static_cast<float>(axis[k]);
+    // Rounded the way that widens the cone.
+    cone.cos_half = std::nextafter(static_cast<float>(c), -1.0f);
+    cone.sin_half = std::nextafter(static_cast<float>(std::sqrt(std::max(0.0, 1.0 - c * c))), 2.0f);
+  }
+}
+
 namespace {
 
 /// A nanoflann result set that hands each point within sqrt(*radius2) of the query to `visit(index,
@@ -385,6 +394,7 @@ constexpr std::size_t kMaxOppositeVisits = std::size_t{1} << 14;
 double ReferenceSurface::Impl::opposite_side(const Vec3& p, const Vec3& normal, double limit, bool first) const {
   constexpr double kOpposite = -0.3;
   if (!(limit > 0)) return std::numeric_limits<double>::infinity();
+  std::call_once(cones_built, [this] { build_cones(); });
   double best2 = limit * limit;
   bool any = false;
   auto consider = [&](const Triangle& tri) {
@@ -399,8 +409,8 @@ double ReferenceSurface::Impl::opposite_side(const Vec3& p, const Vec3& normal, 
     if (c2 < best2) best2 = c2, any = true;
   };
   // A triangle nearer than `limit` (later: than the nearest found) has every corner v within that
-  // distance plus vertex_reach[v] of p; those with an edge longer than search_reach are looked at
-  // from the list (Impl::search_reach).
+  // distance plus vertex_reach[v] of p; those with an edge longer than search_reach are found
+  // through long_tree (Impl::search_reach).
   double radius2 = (limit + search_reach) * (limit + search_reach);
   std::size_t visits = 0;
   auto visit = [&](std::uint32_t v, double d2) {
@@ -414,8 +424,10 @@ double ReferenceSurface::Impl::opposite_side(const Vec3& p, const Vec3& normal, 
     const double star_reach = std::sqrt(best2) + star.radius;
     if ((star.centre - p).sqrnorm() > star_reach * star_reach) return true;
     const Cone& cone = cones[v];
-    const double ca = cone.axis | normal, sa = std::sqrt(std::max(0.0, 1.0 - ca * ca));
-    if (ca * cone.sin_half + sa * cone.cos_half > 1e-9 && ca * cone.cos_half - sa * cone.sin_half >= kOpposite + 1e-9)
+    const double ca = std::clamp(cone.axis[0] * normal[0] + cone.axis[1] * normal[1] + cone.axis[2] * normal[2], -1.0, 1.0);
+    const double sa = std::sqrt(1.0 - ca * ca);
+    if (ca * cone.sin_half + sa * cone.cos_half > kConeMargin &&
+        ca * cone.cos_half - sa * cone.sin_half >= kOpposite + kConeMargin)
       return true;
     for (std::uint32_t j = vertex_triangles.offsets[v]; j < vertex_triangles.offsets[v + 1]; ++j)
       consider(triangles[vertex_triangles.items[j]]);
