@@ -101,7 +101,11 @@ Job parse_job(const std::vector<std::string>& args) {
     auto ends = [&](const char* ext) { return s.size() > 4 && s.compare(s.size() - 4, 4, ext) == 0; };
     if (!ends(".csv") && !(s.size() > 5 && s.compare(s.size() - 5, 5, ".json") == 0))
       throw UsageError("--stats: '" + s + "' must end in .csv or .json");
-    require_writable(s);
+    try {
+      require_writable(s);
+    } catch (const UsageError& e) {
+      throw UsageError(std::string("--stats: ") + e.what());
+    }
   }
   return job;
 }

@@ -144,9 +144,9 @@ TEST_CASE("bad arguments exit with 2 and one line on stderr", "[cli]") {
   cases.push_back({{mesh, "/proc/out.obj", "--emin", "0.2", "--emax", "0.3"}, "/proc"});
   cases.push_back({{mesh, out, "--emin", "0.2", "--emax", "0.3", "--dual", "/proc/d.xyz"}, "/proc"});
   // The statistics file too: it was found unwritable only after the run (exit 1, the mesh written).
-  cases.push_back({{mesh, out, "--emin", "0.2", "--emax", "0.3", "--stats", "/proc/s.csv"}, "/proc"});
+  cases.push_back({{mesh, out, "--emin", "0.2", "--emax", "0.3", "--stats", "/proc/s.csv"}, "--stats: cannot write"});
   cases.push_back({{mesh, out, "--emin", "0.2", "--emax", "0.3", "--stats", dir.file("no_such_dir/s.json")},
-                   "no_such_dir"});
+                   "--stats: output directory does not exist"});
   cases.push_back({{mesh, out, "--emin", "0.2", "--emax", "0.3", "--stats", dir.file("taken.obj")}, "--stats"});
 #endif
   for (const auto& c : cases) {
