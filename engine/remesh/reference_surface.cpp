@@ -395,18 +395,18 @@ double ReferenceSurface::Impl::opposite_side(const Vec3& p, const Vec3& normal, 
   constexpr double kOpposite = -0.3;
   if (!(limit > 0)) return std::numeric_limits<double>::infinity();
   std::call_once(cones_built, [this] { build_cones(); });
-  double best2 = limit * limit;
+  double best2 = limit * limit, best = limit;  // the nearest found (squared and not), else the limit
   bool any = false;
   auto consider = [&](const Triangle& tri) {
     if ((tri.normal | normal) >= kOpposite) return;
     // Every point of the triangle lies within its radius of its centre (the margin keeps the test
     // conservative against rounding).
-    const double reach = (std::sqrt(best2) + tri.radius) * (1.0 + 1e-9);
+    const double reach = (best + tri.radius) * (1.0 + 1e-9);
     if ((tri.centre - p).sqrnorm() > reach * reach) return;
     const Vec3 c = geom::closest_point_on_triangle(p, points[tri.corners[0]], points[tri.corners[1]],
                                                    points[tri.corners[2]]);
     const double c2 = (c - p).sqrnorm();
-    if (c2 < best2) best2 = c2, any = true;
+    if (c2 < best2) best2 = c2, best = std::sqrt(c2), any = true;
   };
   // A triangle nearer than `limit` (later: than the nearest found) has every corner v within that
   // distance plus vertex_reach[v] of p; those with an edge longer than search_reach are found
@@ -415,13 +415,13 @@ double ReferenceSurface::Impl::opposite_side(const Vec3& p, const Vec3& normal, 
   std::size_t visits = 0;
   auto visit = [&](std::uint32_t v, double d2) {
     if (++visits > kMaxOppositeVisits) return false;
-    const double reach = std::sqrt(best2) + vertex_reach[v];
+    const double reach = best + vertex_reach[v];
     if (d2 > reach * reach) return true;
     // Passed over whole: a star that lies farther than the nearest found, or whose triangles all
     // face too much the same way as `normal` (its cone: their normals lie within its half-angle
     // of its axis, so none is more than the axis' angle to `normal` plus that half-angle from it).
     const Star& star = stars[v];
-    const double star_reach = std::sqrt(best2) + star.radius;
+    const double star_reach = best + star.radius;
     if ((star.centre - p).sqrnorm() > star_reach * star_reach) return true;
     const Cone& cone = cones[v];
     const double ca = std::clamp(cone.axis[0] * normal[0] + cone.axis[1] * normal[1] + cone.axis[2] * normal[2], -1.0, 1.0);
@@ -432,7 +432,7 @@ double ReferenceSurface::Impl::opposite_side(const Vec3& p, const Vec3& normal, 
     for (std::uint32_t j = vertex_triangles.offsets[v]; j < vertex_triangles.offsets[v + 1]; ++j)
       consider(triangles[vertex_triangles.items[j]]);
     if (any && first) return false;
-    const double r = std::sqrt(best2) + search_reach;
+    const double r = best + search_reach;
     radius2 = std::min(radius2, r * r);
     return true;
   };
@@ -440,19 +440,19 @@ double ReferenceSurface::Impl::opposite_side(const Vec3& p, const Vec3& normal, 
   const double q[3] = {p[0], p[1], p[2]};
   tree->findNeighbors(each, q, nanoflann::SearchParams(32, 0.0f, false));
   if (long_tree && !(any && first) && visits <= kMaxOppositeVisits) {
-    double long_radius2 = (std::sqrt(best2) + long_reach) * (std::sqrt(best2) + long_reach);
+    double long_radius2 = (best + long_reach) * (best + long_reach);
     auto visit_long = [&](std::uint32_t i, double) {
       if (++visits > kMaxOppositeVisits) return false;
       consider(triangles[long_triangles[i]]);
       if (any && first) return false;
-      const double r = std::sqrt(best2) + long_reach;
+      const double r = best + long_reach;
       long_radius2 = std::min(long_radius2, r * r);
       return true;
     };
     VisitEach<decltype(visit_long)> each_long{&long_radius2, &visit_long};
     long_tree->findNeighbors(each_long, q, nanoflann::SearchParams(32, 0.0f, false));
   }
-  return any ? std::sqrt(best2) : std::numeric_limits<double>::infinity();
+  return any ? best : std::numeric_limits<double>::infinity();
 }
 
 double ReferenceSurface::opposite_side_distance(const Vec3& p, const Vec3& normal, double limit) const {

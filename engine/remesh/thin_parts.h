@@ -42,15 +42,14 @@ struct ThinParts {
 };
 
 /// Vertices thin_parts() measures the thickness at, at most. A vertex where the input is thinner
-/// costs little (the search stops at the first triangle across: ReferenceSurface::
-/// opposite_side_within), one where it is thicker 5-10 us (the search finds none). Measured, one
-/// thread, Table 4.2 setup: cheese refined (5 213 vertices, all but 6 thinner) 0.205 -> 0.007 s
-/// against the full search for the nearest; armadillo simplified (10 124) 0.173 -> 0.110 s,
-/// nefertiti simplified (11 408) 0.151 -> 0.092 s, cow refined (6 121) 0.027 -> 0.016 s, with the
-/// same counts; the long triangles in a kd-tree of their own then took armadillo simplified to
-/// 0.059 s and refined 0.131 -> 0.057 s, nefertiti simplified to 0.063 s. A share estimated from that many
-/// is within half a point; from 5 000 a point (cow: 89.5 % regular where thick against 89.4 %,
-/// spot 88.9 against 89.1 %: the sample made spot look less regular where thick than overall).
+/// costs little (ReferenceSurface::opposite_side_within stops at the first triangle across), one
+/// where it is thicker 3-7 us (the search must find none). Measured, one thread, Table 4.2 setup,
+/// against the earlier search that collected the whole ball and found the nearest: cheese refined
+/// (5 213 vertices, all but 6 thinner) 0.205 -> 0.005 s, cow refined (6 121) 0.027 -> 0.014 s,
+/// armadillo simplified (10 124) 0.173 -> 0.059 s, nefertiti simplified (11 408) 0.151 -> 0.063 s,
+/// the same counts. A share estimated from that many is within half a point; from 5 000 a point
+/// (cow: 89.5 % regular where thick against 89.4 %, spot 88.9 against 89.1 %: the sample made spot
+/// look less regular where thick than overall).
 constexpr std::size_t kThicknessSample = 20000;
 
 /// The reference's thickness at vertex v of `mesh`: the distance from v to the nearest reference
