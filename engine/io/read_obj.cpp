@@ -35,7 +35,7 @@ void parse_face(std::string_view rest, std::size_t line, RawSoup& soup) {
     if (!parse_int(index, i)) fail_at(line, "bad face index " + quote(tok));
     if (i == 0) fail_at(line, "face index 0 is invalid (OBJ indices start at 1)");
     if (i < 0) {
-      if (-i > defined)
+      if (i < -defined)  // not -i > defined: -i overflows for the smallest int64
         fail_at(line, "relative face index " + std::to_string(i) + " reaches before the first vertex (" +
                           std::to_string(defined) + " defined so far)");
       soup.indices.push_back(defined + i);

@@ -127,3 +127,28 @@ TEST_CASE("Vertices snapped onto a neighbour or an edge give a valid mesh withou
     CHECK(whole * 10 >= trials * 9);
   }
 }
+
+TEST_CASE("Extreme integers where the text formats read indices and counts give an error, not overflow") {
+  // Under UBSan (test_io_asan) an overflowing negation or sum aborts the test. The OBJ reader
+  // negated a relative index of -2^63 to compare it with the vertex count.
+  const std::string extremes[] = {"-9223372036854775808", "-9223372036854775807", "9223372036854775807",
+                                  "18446744073709551615", "-4", "4294967296", "-4294967296"};
+  for (const std::string& x : extremes) {
+    INFO(x);
+    Outcome outcome;
+    const std::string vertices = "v 0 0 0\nv 1 0 0\nv 0 1 0\n";
+    try_variant(vertices + "f 1 2 " + x + "\n", Format::Obj, "obj face index " + x, outcome);
+    try_variant(vertices + "f " + x + "/1/1 2/1/1 3/1/1\n", Format::Obj, "obj face index with slashes " + x, outcome);
+    try_variant("OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 " + x + "\n", Format::Off, "off face index " + x, outcome);
+    try_variant("OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n" + x + " 0 1 2\n", Format::Off, "off face size " + x, outcome);
+    try_variant("OFF\n" + x + " 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n", Format::Off, "off vertex count " + x, outcome);
+    try_variant("ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+                "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 " +
+                    x + "\n",
+                Format::Ply, "ply face index " + x, outcome);
+    try_variant("ply\nformat ascii 1.0\nelement vertex " + x +
+                    "\nproperty float x\nproperty float y\nproperty float z\nend_header\n0 0 0\n",
+                Format::Ply, "ply vertex count " + x, outcome);
+    CHECK(outcome.meshes == 0);
+  }
+}
