@@ -10,6 +10,7 @@
 #include <array>
 #include <cstring>
 #include <cmath>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -294,8 +295,16 @@ RawSoup read_gltf(std::string_view bytes, bool binary, const ReadOptions& option
   std::string err, warn;
   const auto* data = reinterpret_cast<const unsigned char*>(bytes.data());
   const auto size = static_cast<unsigned int>(bytes.size());
-  bool ok = binary ? loader.LoadBinaryFromMemory(&model, &err, &warn, data, size, "")
-                   : loader.LoadASCIIFromString(&model, &err, &warn, bytes.data(), size, "");
+  bool ok = false;
+  try {
+    ok = binary ? loader.LoadBinaryFromMemory(&model, &err, &warn, data, size, "")
+                : loader.LoadASCIIFromString(&model, &err, &warn, bytes.data(), size, "");
+  } catch (const std::exception& e) {
+    // tinygltf 2.5 reads some malformed files through std::vector::at (a GLB whose buffer has
+    // byteLength 0: its BIN chunk is copied to data.at(0)), which throws std::out_of_range.
+    fail(std::string(binary ? "GLB" : "glTF") + ": malformed structure the glTF loader could not read (" +
+         e.what() + ")");
+  }
   if (!guard.first_external.empty())
     fail("glTF refers to an external file " + quote(guard.first_external) +
          "; only embedded data (data: URIs or .glb) is accepted");

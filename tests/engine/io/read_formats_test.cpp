@@ -309,6 +309,23 @@ TEST_CASE("GLB: accessor and bufferView offsets whose sums wrap round 2^64 are r
   CHECK_THROWS_WITH(read_as(glb("0", "", "40", "1")), Catch::Contains("reaches past the end"));
 }
 
+TEST_CASE("GLB: a buffer of byteLength 0 is a malformed file, not an escaped std::out_of_range") {
+  // tinygltf copies the BIN chunk to data.at(0) of the buffer, which throws on an empty one: the
+  // CLI said "error: vector::_M_range_check" and exited 1 as for an internal error.
+  const std::string json = R"({"asset": {"version": "2.0"}, "buffers": [{"byteLength": 0}]}   )";
+  REQUIRE(json.size() % 4 == 0);
+  std::string out = "glTF";
+  auto put32 = [&](std::uint32_t v) { out.append(reinterpret_cast<const char*>(&v), 4); };
+  put32(2);
+  put32(static_cast<std::uint32_t>(12 + 8 + json.size() + 8 + 4));
+  put32(static_cast<std::uint32_t>(json.size()));
+  out += "JSON" + json;
+  put32(4);
+  out += std::string("BIN\0", 4) + std::string(4, '\0');
+  CHECK_THROWS_AS(read_as(out), MeshError);
+  CHECK_THROWS_WITH(read_as(out), Catch::StartsWith("GLB: malformed structure"));
+}
+
 TEST_CASE("A UTF-8 byte order mark before a text format is passed over: the same mesh as without it") {
   const std::string bom = "\xEF\xBB\xBF";
   const std::string obj = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n";
