@@ -14,6 +14,7 @@
 
 #include "io/degenerate_faces.h"
 #include "io/parse_util.h"
+#include "io/point_hash.h"
 #include "io/repair.h"
 
 namespace remesh::io {
@@ -73,14 +74,12 @@ TriSoup triangulate(RawSoup& raw, const ReadOptions& options, std::vector<Repair
 void weld(TriSoup& soup, std::vector<Repair>& repairs) {
   struct Hash {
     std::size_t operator()(const Vec3& p) const {
-      std::uint64_t h = 1469598103934665603ull;
+      std::uint64_t bits[3];
       for (int i = 0; i < 3; ++i) {
-        double v = p[i] + 0.0;
-        std::uint64_t b;
-        std::memcpy(&b, &v, 8);
-        h = (h ^ b) * 1099511628211ull ^ (h >> 31);
+        const double v = p[i] + 0.0;  // -0.0 == 0.0
+        std::memcpy(&bits[i], &v, 8);
       }
-      return static_cast<std::size_t>(h);
+      return static_cast<std::size_t>(point_hash(bits));
     }
   };
   std::unordered_map<Vec3, std::uint32_t, Hash> first;

@@ -8,6 +8,7 @@
 #include <unordered_map>
 
 #include "io/parse_util.h"
+#include "io/point_hash.h"
 #include "io/soup.h"
 
 namespace remesh::io {
@@ -41,11 +42,7 @@ class Welder {
     bool operator==(const Key& o) const { return std::memcmp(bits, o.bits, sizeof bits) == 0; }
   };
   struct Hash {
-    std::size_t operator()(const Key& k) const {
-      std::uint64_t h = 1469598103934665603ull;
-      for (std::uint64_t b : k.bits) h = (h ^ b) * 1099511628211ull ^ (h >> 29);
-      return static_cast<std::size_t>(h);
-    }
+    std::size_t operator()(const Key& k) const { return static_cast<std::size_t>(point_hash(k.bits)); }
   };
   RawSoup& soup_;
   std::unordered_map<Key, std::size_t, Hash> map_;

@@ -4,9 +4,14 @@
 #include <catch2/catch.hpp>
 
 #include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
 #include <random>
 
 #include "io/mesh_io.h"
+#include "io/point_hash.h"
 #include "io_test_util.h"
 #include "support/mesh_generators.h"
 
@@ -151,4 +156,59 @@ TEST_CASE("Extreme integers where the text formats read indices and counts give 
                 Format::Ply, "ply vertex count " + x, outcome);
     CHECK(outcome.meshes == 0);
   }
+}
+
+TEST_CASE("Corners crafted to share one hash under an unkeyed mix spread over the welders' buckets") {
+  // The welders' old hash, h = ((h ^ b) * P) ^ (h >> 29) over the three coordinates' bits, can be
+  // inverted: pick x and y, solve for the bits of z that give any chosen value T. An ASCII STL of
+  // 200 000 such corners took 63 s to read (every insert walked one bucket chain); point_hash is
+  // keyed per process, so the same corners land in buckets as random ones would.
+  constexpr std::uint64_t kPrime = 1099511628211ull, kBasis = 1469598103934665603ull, kTarget = 0x0123456789abcdefull;
+  std::uint64_t inverse = kPrime;  // Newton's iteration for the inverse modulo 2^64
+  for (int i = 0; i < 6; ++i) inverse *= 2 - kPrime * inverse;
+  REQUIRE(kPrime * inverse == 1);
+  auto step = [&](std::uint64_t h, std::uint64_t b) { return ((h ^ b) * kPrime) ^ (h >> 29); };
+  auto bits = [](double v) {
+    std::uint64_t b;
+    std::memcpy(&b, &v, 8);
+    return b;
+  };
+  std::vector<std::array<std::uint64_t, 3>> corners;
+  for (int i = 1; corners.size() < 2000; ++i) {
+    const std::uint64_t bx = bits(i), by = bits(i % 7);
+    const std::uint64_t h = step(step(kBasis, bx), by);
+    const std::uint64_t bz = h ^ ((kTarget ^ (h >> 29)) * inverse);
+    double z;
+    std::memcpy(&z, &bz, 8);
+    if (!std::isfinite(z) || z == 0) continue;
+    REQUIRE(step(h, bz) == kTarget);  // all share the old hash
+    corners.push_back({bx, by, bz});
+  }
+  constexpr std::uint64_t kBuckets = 10007;
+  std::vector<bool> used(kBuckets, false);
+  std::size_t distinct = 0;
+  for (const auto& c : corners) {
+    const std::uint64_t b = io::point_hash(c.data()) % kBuckets;
+    distinct += !used[b];
+    used[b] = true;
+  }
+  // 2 000 random keys in 10 007 buckets fill about 1 813 of them.
+  CHECK(distinct >= 1600);
+  // And they are read as 2 000 distinct corners.
+  std::string stl = "solid c\n";
+  for (std::size_t k = 0; k + 2 < corners.size(); k += 3) {
+    stl += "facet normal 0 0 0\nouter loop\n";
+    for (std::size_t j = k; j < k + 3; ++j) {
+      double p[3];
+      std::memcpy(p, corners[j].data(), sizeof p);
+      char line[128];
+      std::snprintf(line, sizeof line, "vertex %.17g %.17g %.17g\n", p[0], p[1], p[2]);
+      stl += line;
+    }
+    stl += "endloop\nendfacet\n";
+  }
+  stl += "endsolid c\n";
+  Outcome outcome;
+  try_variant(stl, Format::Stl, "crafted corners", outcome);  // a valid mesh (most faces are slivers, dropped)
+  CHECK(outcome.meshes == 1);
 }
