@@ -300,7 +300,7 @@ RawSoup read_gltf(std::string_view bytes, bool binary, const ReadOptions& option
     ok = binary ? loader.LoadBinaryFromMemory(&model, &err, &warn, data, size, "")
                 : loader.LoadASCIIFromString(&model, &err, &warn, bytes.data(), size, "");
   } catch (const std::exception& e) {
-    // tinygltf 2.5 reads some malformed files through std::vector::at (a GLB whose buffer has
+    // tinygltf 2.7 reads some malformed files through std::vector::at (a GLB whose buffer has
     // byteLength 0: its BIN chunk is copied to data.at(0)), which throws std::out_of_range.
     fail(std::string(binary ? "GLB" : "glTF") + ": malformed structure the glTF loader could not read (" +
          e.what() + ")");

@@ -161,7 +161,7 @@ TEST_CASE("Extreme integers where the text formats read indices and counts give 
 TEST_CASE("Corners crafted to share one hash under an unkeyed mix spread over the welders' buckets") {
   // The welders' old hash, h = ((h ^ b) * P) ^ (h >> 29) over the three coordinates' bits, can be
   // inverted: pick x and y, solve for the bits of z that give any chosen value T. An ASCII STL of
-  // 200 000 such corners took 63 s to read (every insert walked one bucket chain); point_hash is
+  // 200 000 such corners took 67 s to read (every insert walked one bucket chain); point_hash is
   // keyed per process, so the same corners land in buckets as random ones would.
   constexpr std::uint64_t kPrime = 1099511628211ull, kBasis = 1469598103934665603ull, kTarget = 0x0123456789abcdefull;
   std::uint64_t inverse = kPrime;  // Newton's iteration for the inverse modulo 2^64
