@@ -152,12 +152,12 @@ std::string iso8601(double unix_seconds) {
 std::string_view outcome_name(Outcome o) { return remesh::outcome_name(o); }
 
 const std::vector<std::string>& remeshed_formats() {
-  static const std::vector<std::string> f = {"obj", "glb", "ply", "off", "stl"};
+  static const std::vector<std::string> f = {"obj", "glb", "ply", "off", "stl", "lammps"};
   return f;
 }
 
 const std::vector<std::string>& dual_formats() {
-  static const std::vector<std::string> f = {"obj", "glb", "ply", "off", "xyz"};
+  static const std::vector<std::string> f = {"obj", "glb", "ply", "off", "xyz", "lammps"};
   return f;
 }
 

@@ -88,8 +88,8 @@ JobRecord job_from_json(const nlohmann::json& j);
 std::string_view outcome_name(Outcome o);
 
 /// Result kinds and the formats each can be downloaded in.
-const std::vector<std::string>& remeshed_formats();  ///< obj, glb, ply, off, stl
-const std::vector<std::string>& dual_formats();      ///< obj, glb, ply, off, xyz
+const std::vector<std::string>& remeshed_formats();  ///< obj, glb, ply, off, stl, lammps
+const std::vector<std::string>& dual_formats();      ///< obj, glb, ply, off, xyz, lammps
 
 /// A fresh job id: 128 random bits from std::random_device as 32 lowercase hex characters.
 std::string new_job_id();

@@ -35,11 +35,18 @@ std::optional<Format> format_from_content_type(std::string_view content_type) {
   return std::nullopt;
 }
 
+namespace {
+
+/// Formats the service reads uploads in (XYZ and LAMMPS data are written only).
+bool readable(Format f) { return f != Format::Xyz && f != Format::Lammps; }
+
+}  // namespace
+
 std::optional<Format> resolve_format(std::string_view format_param, std::string_view filename,
                                      std::string_view content_type, std::vector<FieldError>& errors) {
   if (!format_param.empty()) {
     auto f = parse_format(format_param);
-    if (!f || *f == Format::Xyz) {
+    if (!f || !readable(*f)) {
       errors.push_back({"format", "unknown mesh format '" + std::string(format_param.substr(0, 40)) +
                                       "' (obj, off, ply, stl, gltf, glb)"});
       return std::nullopt;
@@ -48,7 +55,7 @@ std::optional<Format> resolve_format(std::string_view format_param, std::string_
   }
   if (filename.find('.') != std::string_view::npos) {
     auto f = parse_format(filename);
-    if (f && *f != Format::Xyz) return f;
+    if (f && readable(*f)) return f;
   }
   return format_from_content_type(content_type);
 }

@@ -431,12 +431,18 @@ JobManager::Batch JobManager::poll(const std::string& id, std::size_t cursor, do
 
 std::filesystem::path JobManager::file(const std::string& id, const std::string& name) {
   std::filesystem::path path = store_.file_path(id, name);
-  if (name.rfind("input.", 0) != 0 || std::filesystem::exists(path)) return path;
+  if (std::filesystem::exists(path)) return path;
+  const bool input = name.starts_with("input.");
+  // A result in a format added after its job finished is made from the job's OBJ of that mesh.
+  const std::size_t dot = name.find('.');
+  const std::filesystem::path obj = store_.file_path(id, name.substr(0, dot) + ".obj");
+  if (!input && (dot == std::string::npos || !std::filesystem::exists(obj))) return path;
   std::lock_guard file_lock(file_mutex_);
   if (std::filesystem::exists(path)) return path;
   auto rec = record(id);
   if (!rec) throw std::runtime_error("job not found");
-  std::string bytes = convert_input(*rec, store_.read_upload(id), name.substr(6));
+  std::string bytes = input ? convert_input(*rec, store_.read_upload(id), name.substr(6))
+                            : convert_result(read_file(obj), name.substr(dot + 1));
   store_.write_file(id, name, bytes);
   return path;
 }

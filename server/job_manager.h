@@ -91,8 +91,9 @@ class JobManager {
   /// Wakes every waiting poll (shutdown).
   void wake_all();
 
-  /// Path of a stored file of a job, e.g. "remeshed.obj"; for "input.<fmt>" the file is made on
-  /// first use. Throws std::runtime_error (engine or I/O) while making it.
+  /// Path of a stored file of a job, e.g. "remeshed.obj"; for "input.<fmt>", and for a result in a
+  /// format its job finished without (added to the service since), the file is made on first use
+  /// (the latter from the result's OBJ). Throws std::runtime_error (engine or I/O) while making it.
   std::filesystem::path file(const std::string& id, const std::string& name);
 
   Gauges gauges() const;

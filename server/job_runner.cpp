@@ -1,5 +1,6 @@
 #include "job_runner.h"
 
+#include <charconv>
 #include <stdexcept>
 
 #include "dual/relax_bonds.h"
@@ -68,6 +69,43 @@ RunOutput run_job(const remesh::api::JobRecord& job, std::string upload, unsigne
 std::string convert_input(const remesh::api::JobRecord& job, std::string_view upload, const std::string& format) {
   remesh::LoadedMesh loaded = read_input(job, upload);
   return remesh::write_mesh(loaded.mesh, format_of(format));
+}
+
+std::string convert_result(std::string_view obj, const std::string& format) {
+  remesh::PolygonSoup soup;
+  auto fail = [] { throw std::runtime_error("the stored OBJ result is malformed"); };
+  // The numbers of a line after its keyword, as doubles (whitespace-separated).
+  auto numbers = [&](std::string_view line, auto&& take) {
+    std::size_t i = 0;
+    while (i < line.size()) {
+      while (i < line.size() && line[i] == ' ') ++i;
+      if (i == line.size()) break;
+      double x = 0;
+      const auto [end, ec] = std::from_chars(line.data() + i, line.data() + line.size(), x);
+      if (ec != std::errc()) fail();
+      take(x);
+      i = static_cast<std::size_t>(end - line.data());
+    }
+  };
+  while (!obj.empty()) {
+    const std::size_t nl = obj.find('\n');
+    std::string_view line = obj.substr(0, nl);
+    obj.remove_prefix(nl == std::string_view::npos ? obj.size() : nl + 1);
+    if (line.starts_with("v ")) {
+      remesh::Vec3 p(0, 0, 0);
+      int k = 0;
+      numbers(line.substr(2), [&](double x) { k < 3 ? void(p[k++] = x) : fail(); });
+      if (k != 3) fail();
+      soup.points.push_back(p);
+    } else if (line.starts_with("f ")) {
+      numbers(line.substr(2), [&](double i) {
+        if (!(i >= 1 && i <= static_cast<double>(soup.points.size()))) fail();
+        soup.indices.push_back(static_cast<std::uint32_t>(i) - 1);
+      });
+      soup.offsets.push_back(static_cast<std::uint32_t>(soup.indices.size()));
+    }
+  }
+  return remesh::write_mesh(soup, format_of(format));
 }
 
 }  // namespace remeshd

@@ -36,4 +36,8 @@ RunOutput run_job(const remesh::api::JobRecord& job, std::string upload, unsigne
 /// The validated input (read as the job read it) in `format` ("obj", "glb", ...).
 std::string convert_input(const remesh::api::JobRecord& job, std::string_view upload, const std::string& format);
 
+/// A result run_job() wrote as OBJ (`obj`, its bytes: "v x y z" and "f i j k ..." lines, polygons
+/// kept) in `format`: for a job finished by a daemon that did not write that format yet.
+std::string convert_result(std::string_view obj, const std::string& format);
+
 }  // namespace remeshd

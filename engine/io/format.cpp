@@ -20,6 +20,7 @@ std::string_view format_name(Format f) {
     case Format::Gltf: return "gltf";
     case Format::Glb: return "glb";
     case Format::Xyz: return "xyz";
+    case Format::Lammps: return "lammps";
   }
   return "unknown";
 }
@@ -33,6 +34,7 @@ std::string_view mime_type(Format f) {
     case Format::Gltf: return "model/gltf+json";
     case Format::Glb: return "model/gltf-binary";
     case Format::Xyz: return "chemical/x-xyz";
+    case Format::Lammps: return "text/plain; charset=utf-8";
   }
   return "application/octet-stream";
 }
@@ -48,8 +50,9 @@ std::optional<Format> parse_format(std::string_view name_or_path) {
   std::transform(lower.begin(), lower.end(), lower.begin(),
                  [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
   for (Format f : {Format::Obj, Format::Off, Format::Ply, Format::Stl, Format::Gltf, Format::Glb,
-                   Format::Xyz})
+                   Format::Xyz, Format::Lammps})
     if (lower == format_name(f)) return f;
+  if (lower == "lmp" || lower == "data") return Format::Lammps;
   return std::nullopt;
 }
 

@@ -44,9 +44,10 @@
 
 namespace remesh {
 
-enum class Format { Obj, Off, Ply, Stl, Gltf, Glb, Xyz };
+enum class Format { Obj, Off, Ply, Stl, Gltf, Glb, Xyz, Lammps };
 
-/// "obj", "off", "ply", "stl", "gltf", "glb", "xyz".
+/// "obj", "off", "ply", "stl", "gltf", "glb", "xyz", "lammps". parse_format() also takes "lmp" and
+/// "data" (the usual extensions of LAMMPS data files) for Lammps.
 std::string_view format_name(Format f);
 /// Parses a name or extension ("obj", ".OBJ", "mesh.ply" -> Ply); nullopt if unknown.
 std::optional<Format> parse_format(std::string_view name_or_path);
@@ -89,7 +90,9 @@ PolygonSoup to_soup(const PolyMesh& mesh);
 
 /// Serialises to bytes. Polygons: OBJ/OFF/PLY keep them; STL fan-triangulates; GLB writes a
 /// triangle-fan primitive plus a LINES primitive of the true polygon edges; XYZ writes one atom
-/// ("C x y z") per point. Gltf is written as GLB. Throws std::invalid_argument for unsupported.
+/// ("C x y z") per point; Lammps writes a LAMMPS data file (atom_style bond): one carbon atom per
+/// point and one bond per edge of the faces, in a box 5 % wider than their bounding box. Gltf is
+/// written as GLB. XYZ and Lammps are written, not read. Throws std::invalid_argument for unsupported.
 std::string write_mesh(const PolygonSoup& soup, Format format);
 std::string write_mesh(const TriMesh& mesh, Format format);
 std::string write_mesh(const PolyMesh& mesh, Format format);

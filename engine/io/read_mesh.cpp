@@ -33,6 +33,7 @@ LoadedMesh read_mesh(std::string_view bytes, const ReadOptions& options) {
     case Format::Gltf: soup = io::read_gltf(bytes, false, options); break;
     case Format::Glb: soup = io::read_gltf(bytes, true, options); break;
     case Format::Xyz: throw MeshError("unsupported input format xyz (a point list has no faces)");
+    case Format::Lammps: throw MeshError("unsupported input format lammps (atoms and bonds, no faces)");
   }
   // The OBJ reader passes over lines it does not know: a PLY or OFF file under an .obj name reads
   // as empty. Say what the content looks like instead of "no vertices and no faces".

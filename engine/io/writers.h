@@ -11,6 +11,7 @@ namespace remesh::io {
 std::string write_obj(const PolygonSoup& soup);  ///< shortest round-trip decimal coordinates
 std::string write_off(const PolygonSoup& soup);  ///< ASCII OFF, polygons kept
 std::string write_xyz(const PolygonSoup& soup);  ///< "C x y z" per point
+std::string write_lammps(const PolygonSoup& soup);  ///< LAMMPS data: atoms, bonds along face edges
 std::string write_ply(const PolygonSoup& soup);  ///< binary little endian, double coordinates
 std::string write_stl(const PolygonSoup& soup);  ///< binary, fan-triangulated, float32
 std::string write_glb(const PolygonSoup& soup);  ///< triangles (+ LINES of polygon edges)

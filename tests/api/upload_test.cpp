@@ -46,6 +46,8 @@ TEST_CASE("formats come from the parameter, the file name, then the Content-Type
       {"", "a.unknown", "model/obj", Format::Obj, false},
       {"fbx", "a.obj", "", std::nullopt, true},
       {"xyz", "", "", std::nullopt, true},
+      {"lammps", "", "", std::nullopt, true},  // written only
+      {"", "atoms.lmp", "model/obj", Format::Obj, false},
   };
   for (const Row& r : rows) {
     INFO(r.param << " | " << r.filename << " | " << r.content_type);

@@ -273,6 +273,20 @@ TEST_CASE("dual writes one polygon per interior vertex", "[cli]") {
   CHECK(lines(read_text(dir.file("dual.xyz"))) >= grid.n_faces());
   REQUIRE(remesh_cli({"dual", dir.file("lattice.obj"), dir.file("dual.glb")}).exit_code == 0);
   CHECK(fs::file_size(dir.file("dual.glb")) > 0);
+  // LAMMPS data: an atom per triangle, and a bond per side of the dual's polygons: across each
+  // interior edge of the grid with an interior end (an edge between two boundary vertices lies
+  // around no interior vertex, so no polygon has its dual edge).
+  REQUIRE(remesh_cli({"dual", dir.file("lattice.obj"), dir.file("dual.lmp")}).exit_code == 0);
+  const std::string data = read_text(dir.file("dual.lmp"));
+  std::size_t interior_edges = 0;
+  for (auto e : grid.edges()) {
+    const auto h = grid.halfedge_handle(e, 0);
+    interior_edges += !grid.is_boundary(e) && !(grid.is_boundary(grid.from_vertex_handle(h)) &&
+                                                grid.is_boundary(grid.to_vertex_handle(h)));
+  }
+  std::string counts = std::to_string(grid.n_faces()) + " atoms\n";
+  counts += std::to_string(interior_edges) + " bonds\n";
+  CHECK(data.find("\n\n" + counts) != std::string::npos);
 }
 
 #ifdef REMESH_CLI_HAS_REMESHER

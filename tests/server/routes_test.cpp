@@ -3,11 +3,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <regex>
 #include <set>
 #include <sstream>
+#include <tuple>
 
 #include "api/json_codec.h"
 #include "daemon.h"
@@ -141,6 +143,27 @@ TEST_CASE("remeshd: submit raw and multipart, follow, download, list, delete", "
   auto glb = c.Get(("/api/v1/jobs/" + id + "/result?mesh=dual&format=glb").c_str());
   REQUIRE(glb);
   CHECK(glb->body.substr(0, 4) == "glTF");
+  // LAMMPS data: the dual's atoms and bonds, the remeshed mesh's vertices and edges.
+  for (const auto& [kind, atoms, bonds] :
+       {std::tuple{"dual", dual["atoms"].get<int>(), dual["bonds"].get<int>()},
+        {"remeshed", done["latest"]["vertices"].get<int>(), done["latest"]["edges"].get<int>()}}) {
+    INFO(kind);
+    const std::string url = "/api/v1/jobs/" + id + "/result?mesh=" + kind + "&format=lammps";
+    auto data = c.Get(url.c_str());
+    REQUIRE(data);
+    CHECK(data->status == 200);
+    std::string counts = std::to_string(atoms) + " atoms\n";
+    counts += std::to_string(bonds) + " bonds\n";
+    CHECK(data->body.find("\n\n" + counts) != std::string::npos);
+    // A job a daemon finished before it wrote LAMMPS data gets it made from its OBJ, the same bytes.
+    const auto stored = tmp.path / "data" / "jobs" / id / (std::string(kind) + ".lammps");
+    REQUIRE(std::filesystem::remove(stored));
+    auto made = c.Get(url.c_str());
+    REQUIRE(made);
+    CHECK(made->status == 200);
+    CHECK(made->body == data->body);
+    CHECK(std::filesystem::exists(stored));
+  }
 
   // Stats as JSON and CSV agree with the document.
   auto stats = c.Get(("/api/v1/jobs/" + id + "/stats").c_str());

@@ -6,6 +6,8 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <set>
+#include <sstream>
 
 #include "io/mesh_io.h"
 #include "io/summary.h"
@@ -130,6 +132,121 @@ TEST_CASE("XYZ writes one carbon atom per point") {
   }
   CHECK(atoms == soup.points.size());
   CHECK(exact);
+}
+
+namespace {
+
+/// A LAMMPS data file as read_data reads it (header counts and box, Masses, Atoms, Bonds), with
+/// every rule that read_data enforces checked on the way.
+struct LammpsData {
+  std::size_t atoms = 0, bonds = 0, atom_types = 0, bond_types = 0;
+  double lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
+  std::vector<Vec3> positions;                            ///< by atom id - 1
+  std::vector<std::pair<std::size_t, std::size_t>> pairs;  ///< bonded atom ids - 1, by bond id - 1
+};
+
+LammpsData parse_lammps(const std::string& text) {
+  LammpsData d;
+  std::istringstream in(text);
+  std::string line, section;
+  std::getline(in, line);  // the title line
+  while (std::getline(in, line)) {
+    if (line.find_first_not_of(' ') == std::string::npos) continue;
+    std::istringstream l(line);
+    if (line == "Masses" || line.rfind("Atoms", 0) == 0 || line == "Bonds") {
+      section = line.substr(0, line.find(' '));
+      continue;
+    }
+    if (section.empty()) {
+      double a = 0, b = 0;
+      std::string w1, w2;
+      l >> a >> w1;
+      if (w1 == "atoms") d.atoms = static_cast<std::size_t>(a);
+      else if (w1 == "bonds") d.bonds = static_cast<std::size_t>(a);
+      else if (w1 == "atom" && (l >> w2, w2 == "types")) d.atom_types = static_cast<std::size_t>(a);
+      else if (w1 == "bond" && (l >> w2, w2 == "types")) d.bond_types = static_cast<std::size_t>(a);
+      else {
+        std::istringstream box(line);
+        std::string lo_word, hi_word;
+        box >> a >> b >> lo_word >> hi_word;
+        const int k = lo_word == "xlo" ? 0 : lo_word == "ylo" ? 1 : lo_word == "zlo" ? 2 : -1;
+        REQUIRE(k >= 0);
+        d.lo[k] = a, d.hi[k] = b;
+      }
+    } else if (section == "Atoms") {
+      std::size_t id = 0, molecule = 0, type = 0;
+      Vec3 p;
+      REQUIRE(static_cast<bool>(l >> id >> molecule >> type >> p[0] >> p[1] >> p[2]));
+      REQUIRE(id == d.positions.size() + 1);
+      CHECK((type >= 1 && type <= d.atom_types));
+      d.positions.push_back(p);
+    } else if (section == "Bonds") {
+      std::size_t id = 0, type = 0, a = 0, b = 0;
+      REQUIRE(static_cast<bool>(l >> id >> type >> a >> b));
+      REQUIRE(id == d.pairs.size() + 1);
+      CHECK((type >= 1 && type <= d.bond_types));
+      REQUIRE((a >= 1 && a <= d.atoms && b >= 1 && b <= d.atoms && a != b));
+      d.pairs.emplace_back(a - 1, b - 1);
+    }
+  }
+  return d;
+}
+
+/// The edges of a soup's faces, each once, as sorted index pairs.
+std::set<std::pair<std::size_t, std::size_t>> soup_edges(const PolygonSoup& soup) {
+  std::set<std::pair<std::size_t, std::size_t>> edges;
+  for (std::size_t f = 0; f + 1 < soup.offsets.size(); ++f)
+    for (std::uint32_t k = soup.offsets[f]; k < soup.offsets[f + 1]; ++k) {
+      const std::size_t u = soup.indices[k];
+      const std::size_t v = soup.indices[k + 1 < soup.offsets[f + 1] ? k + 1 : soup.offsets[f]];
+      edges.emplace(std::min(u, v), std::max(u, v));
+    }
+  return edges;
+}
+
+}  // namespace
+
+TEST_CASE("LAMMPS data: an atom per point at its exact position, a bond per edge, all inside the box") {
+  std::vector<std::pair<std::string, PolygonSoup>> soups;
+  soups.emplace_back("torus", to_soup(test::make_torus(12, 8, 2.0, 0.5)));
+  soups.emplace_back("sphere", to_soup(test::make_icosphere(2)));
+  soups.emplace_back("cube of quads",
+                     test::make_soup({{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, {0, 0, 1}, {1, 0, 1}, {1, 1, 1}, {0, 1, 1}},
+                                     {{0, 3, 2, 1}, {4, 5, 6, 7}, {0, 1, 5, 4}, {1, 2, 6, 5}, {2, 3, 7, 6}, {3, 0, 4, 7}}));
+  for (const auto& [name, soup] : soups) {
+    INFO(name);
+    const LammpsData d = parse_lammps(write_mesh(soup, Format::Lammps));
+    CHECK(d.atom_types == 1);
+    CHECK(d.bond_types == 1);
+    REQUIRE(d.atoms == soup.points.size());
+    REQUIRE(d.positions.size() == d.atoms);
+    CHECK(d.pairs.size() == d.bonds);
+    bool exact = true, inside = true;
+    for (std::size_t i = 0; i < d.atoms; ++i)
+      for (int k = 0; k < 3; ++k) {
+        exact &= d.positions[i][k] == soup.points[i][k];
+        inside &= d.lo[k] < d.positions[i][k] && d.positions[i][k] < d.hi[k];
+      }
+    CHECK(exact);
+    CHECK(inside);
+    // The bonds are the faces' edges, each once.
+    const auto edges = soup_edges(soup);
+    std::set<std::pair<std::size_t, std::size_t>> bonded;
+    for (auto [a, b] : d.pairs) bonded.emplace(std::min(a, b), std::max(a, b));
+    CHECK(bonded.size() == d.pairs.size());
+    CHECK(bonded == edges);
+  }
+  // The counts of closed surfaces: E = V + F - chi (torus 0, sphere and cube 2).
+  for (const auto& [soup, chi] : {std::pair{&soups[0].second, 0}, {&soups[1].second, 2}, {&soups[2].second, 2}}) {
+    const std::size_t faces = soup->offsets.size() - 1;
+    CHECK(parse_lammps(write_mesh(*soup, Format::Lammps)).bonds == soup->points.size() + faces - chi);
+  }
+  // Written only; its extensions name it.
+  CHECK(parse_format("atoms.lammps") == Format::Lammps);
+  CHECK(parse_format("ATOMS.LMP") == Format::Lammps);
+  CHECK(parse_format("system.data") == Format::Lammps);
+  CHECK_THROWS_WITH(read_mesh(write_mesh(soups[0].second, Format::Lammps), ReadOptions{Format::Lammps}),
+                    Catch::Contains("unsupported input format lammps"));
 }
 
 TEST_CASE("Files: the extension chooses the format, unknown extensions are refused") {

@@ -7,7 +7,10 @@ import { IterationChart } from './charts.js';
 
 const $ = (id) => document.getElementById(id);
 export const FINAL = new Set(['succeeded', 'failed', 'cancelled']);
-const RESULT_FORMATS = { remeshed: ['obj', 'glb', 'ply', 'off', 'stl'], dual: ['obj', 'glb', 'ply', 'off', 'xyz'] };
+const RESULT_FORMATS = {
+  remeshed: ['obj', 'glb', 'ply', 'off', 'stl', 'lammps'],
+  dual: ['obj', 'glb', 'ply', 'off', 'xyz', 'lammps'],
+};
 const TABLE = [
   ['iteration', (v) => v], ['vertices', int], ['edges', int], ['mean', num], ['deviation', num],
   ['regular_percent', (v) => fixed(v, 1)], ['small', int], ['big', int],
