@@ -21,7 +21,7 @@ std::optional<double> Args::get_double(const std::string& name) const {
   const char* end = text->data() + text->size();
   auto [ptr, ec] = std::from_chars(text->data(), end, value);
   if (text->empty() || ec != std::errc() || ptr != end || !std::isfinite(value))
-    throw UsageError("--" + name + ": '" + *text + "' is not a number");
+    throw ValueError(name, "'" + *text + "' is not a number");
   return value;
 }
 
@@ -32,10 +32,9 @@ std::optional<long long> Args::get_int(const std::string& name, long long lo, lo
   const char* end = text->data() + text->size();
   auto [ptr, ec] = std::from_chars(text->data(), end, value);
   if (text->empty() || ec != std::errc() || ptr != end)
-    throw UsageError("--" + name + ": '" + *text + "' is not an integer");
+    throw ValueError(name, "'" + *text + "' is not an integer");
   if (value < lo || value > hi)
-    throw UsageError("--" + name + ": " + *text + " is outside " + std::to_string(lo) + ".." +
-                     std::to_string(hi));
+    throw ValueError(name, *text + " is outside " + std::to_string(lo) + ".." + std::to_string(hi));
   return value;
 }
 

@@ -8,6 +8,7 @@
 #include <fstream>
 #include <iostream>
 #include <optional>
+#include <set>
 
 #include "args.h"
 #include "commands.h"
@@ -62,18 +63,33 @@ Job parse_job(const std::vector<std::string>& args) {
   Job job;
   job.in = a.positional[0];
   job.out = a.positional[1];
+  // Still reported alone, before the values are read (like parse_args' errors): a run without an
+  // interval is refused whatever else is wrong, and the one line names both when both are missing.
   if (!a.has("emin") || !a.has("emax"))
     throw UsageError(std::string("missing required option") +
                      (!a.has("emin") && !a.has("emax") ? "s --emin and --emax" : a.has("emin") ? " --emax" : " --emin"));
+  // Every value is read even after a bad one, so that all bad options are reported at once, with
+  // the range errors of the ones that did parse (README: one line per bad option).
+  std::vector<FieldError> errors;
+  std::set<std::string> unreadable;  // the options whose value did not parse
+  auto read = [&](auto get) {
+    try {
+      return get();
+    } catch (const ValueError& e) {
+      errors.push_back({"--" + e.option(), e.problem()});
+      unreadable.insert("--" + e.option());
+      return decltype(get())();
+    }
+  };
   Params& p = job.params;
-  p.e_min = *a.get_double("emin");
-  p.e_max = *a.get_double("emax");
-  if (auto v = a.get_int("iterations", INT_MIN, INT_MAX)) p.iterations = static_cast<int>(*v);
-  if (auto v = a.get_int("rings", INT_MIN, INT_MAX)) p.rings = static_cast<int>(*v);
-  if (auto v = a.get_int("relax-every", INT_MIN, INT_MAX)) p.relax_every = static_cast<int>(*v);
-  if (auto v = a.get_double("flip-factor")) p.flip_factor = *v;
-  if (auto v = a.get_int("threads", 0, 4096)) p.threads = static_cast<unsigned>(*v);
-  if (auto v = a.get_int("max-faces", 0, LLONG_MAX)) {
+  if (auto v = read([&] { return a.get_double("emin"); })) p.e_min = *v;
+  if (auto v = read([&] { return a.get_double("emax"); })) p.e_max = *v;
+  if (auto v = read([&] { return a.get_int("iterations", INT_MIN, INT_MAX); })) p.iterations = static_cast<int>(*v);
+  if (auto v = read([&] { return a.get_int("rings", INT_MIN, INT_MAX); })) p.rings = static_cast<int>(*v);
+  if (auto v = read([&] { return a.get_int("relax-every", INT_MIN, INT_MAX); })) p.relax_every = static_cast<int>(*v);
+  if (auto v = read([&] { return a.get_double("flip-factor"); })) p.flip_factor = *v;
+  if (auto v = read([&] { return a.get_int("threads", 0, 4096); })) p.threads = static_cast<unsigned>(*v);
+  if (auto v = read([&] { return a.get_int("max-faces", 0, LLONG_MAX); })) {
     p.max_output_faces = static_cast<std::size_t>(*v);
     job.read.max_faces = static_cast<std::size_t>(*v);
   }
@@ -87,11 +103,13 @@ Job parse_job(const std::vector<std::string>& args) {
   job.dual_out = a.get("dual");
   job.stats_out = a.get("stats");
 
-  auto errors = check(p);
-  if (!errors.empty()) {
-    for (auto& e : errors) e.field = option_for(e.field);
-    throw ParamsError(std::move(errors));
+  for (auto& e : check(p)) {
+    e.field = option_for(e.field);
+    // An option whose value did not parse kept its default, which check() may refuse too (e_min
+    // 0): it has its line already.
+    if (!unreadable.count(e.field)) errors.push_back(std::move(e));
   }
+  if (!errors.empty()) throw ParamsError(std::move(errors));
   require_input_file(job.in);
   require_output_format(job.out);
   if (job.dual_out) require_output_format(*job.dual_out);
@@ -107,6 +125,8 @@ Job parse_job(const std::vector<std::string>& args) {
       throw UsageError(std::string("--stats: ") + e.what());
     }
   }
+  // Before the run: the dual, then the statistics, would silently replace a file written before them.
+  require_distinct_outputs({{"OUT", job.out}, {"--dual", job.dual_out}, {"--stats", job.stats_out}});
   return job;
 }
 

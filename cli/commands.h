@@ -6,7 +6,9 @@
 /// anything else -> 1.
 
 #include <iosfwd>
+#include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "dual/dual_stats.h"
@@ -27,6 +29,11 @@ Format require_output_format(const std::string& path);
 /// Throws UsageError unless a file can be written at `path`: its directory exists and takes a new
 /// file, and `path` is no directory.
 void require_writable(const std::string& path);
+/// An output of a command: what names it on the command line ("OUT", "--dual") and its path, if given.
+using NamedOutput = std::pair<std::string, std::optional<std::string>>;
+/// Throws UsageError when two of `outputs` name the same file, however spelled ("a.obj",
+/// "./a.obj", "dir/../a.obj", a symbolic or hard link): the later write would replace the earlier.
+void require_distinct_outputs(const std::vector<NamedOutput>& outputs);
 /// The prologue of commands that read IN and write OUT: checks IN exists and OUT's format and
 /// directory before reading (so no work is wasted on a bad OUT), then reads IN.
 LoadedMesh read_input_for(const std::string& in, const std::string& out, bool weld);

@@ -53,6 +53,48 @@ void require_writable(const std::string& path) {
   }
 }
 
+namespace {
+
+/// The file `path` names: absolute, with "." and ".." and the symbolic links on the way resolved.
+std::filesystem::path resolved(const std::string& path) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  fs::path p = fs::absolute(path, ec);
+  if (ec) return fs::path(path).lexically_normal();
+  fs::path canonical = fs::weakly_canonical(p, ec);
+  p = ec ? p.lexically_normal() : canonical;
+  // weakly_canonical stops at a link whose target does not exist yet, but writing through that
+  // link creates the target: follow it (a bounded number of hops, links may form a loop).
+  for (int hop = 0; hop < 40 && fs::is_symlink(fs::symlink_status(p, ec)); ++hop) {
+    const fs::path target = fs::read_symlink(p, ec);
+    if (ec) break;
+    canonical = fs::weakly_canonical(p.parent_path() / target, ec);  // an absolute target replaces the parent
+    if (ec) break;
+    p = canonical;
+  }
+  return p;
+}
+
+bool same_file(const std::string& a, const std::string& b) {
+  std::error_code ec;
+  // equivalent() also catches hard links; it is false (with ec set) while either file is missing.
+  return std::filesystem::equivalent(a, b, ec) || resolved(a) == resolved(b);
+}
+
+}  // namespace
+
+void require_distinct_outputs(const std::vector<NamedOutput>& outputs) {
+  for (std::size_t i = 0; i < outputs.size(); ++i) {
+    for (std::size_t j = 0; j < i; ++j) {
+      const auto& [name, path] = outputs[i];
+      const auto& [earlier_name, earlier_path] = outputs[j];
+      if (!path || !earlier_path || !same_file(*path, *earlier_path)) continue;
+      throw UsageError(name + " names the same file as " + earlier_name + ": " + *path +
+                       (*path == *earlier_path ? "" : " and " + *earlier_path));
+    }
+  }
+}
+
 void print_repairs(std::ostream& out, const std::vector<Repair>& repairs) {
   for (const auto& r : repairs) out << "  " << r.kind << " (" << r.count << "): " << r.detail << "\n";
 }

@@ -468,6 +468,93 @@ TEST_CASE("the summary says where the time went, step by step, adding up to the 
   CHECK(std::abs(sum - total) <= 0.011);
 }
 
+TEST_CASE("remesh reports every bad option value at once, one line each", "[cli]") {
+  TempDir dir;
+  const std::string mesh = dir.file("sphere.obj"), out = dir.file("out.obj");
+  write_obj(remesh::test::make_icosphere(1), mesh);
+  struct Case {
+    std::vector<std::string> options;
+    std::vector<std::string> lines;  ///< each must be on a line of its own
+  };
+  const std::vector<Case> cases = {
+      // Two values that do not parse, and a range error of one that does.
+      {{"--emin", "abc", "--emax", "xyz", "--rings", "9"},
+       {"--emin: 'abc' is not a number", "--emax: 'xyz' is not a number", "--rings: "}},
+      // Not an integer, outside the parser's range, outside check()'s range.
+      {{"--emin", "0.2", "--emax", "0.3", "--iterations", "1.5", "--threads", "99999", "--flip-factor", "2"},
+       {"--iterations: '1.5' is not an integer", "--threads: 99999 is outside 0..4096", "--flip-factor: "}},
+  };
+  for (const auto& c : cases) {
+    std::vector<std::string> args = {mesh, out};
+    args.insert(args.end(), c.options.begin(), c.options.end());
+    const ProcessResult r = remesh_cli(args);
+    INFO("stderr: " << r.err);
+    CHECK(r.exit_code == 2);
+    CHECK(lines(r.err) == c.lines.size());
+    std::istringstream err(r.err);
+    std::vector<std::string> printed;
+    for (std::string line; std::getline(err, line);) printed.push_back(line);
+    for (const auto& expected : c.lines) {
+      INFO(expected);
+      CHECK(std::count_if(printed.begin(), printed.end(), [&](const std::string& line) {
+              return line.rfind("remesh: ", 0) == 0 && line.find(expected) != std::string::npos;
+            }) == 1);
+    }
+  }
+  CHECK(!fs::exists(out));
+}
+
+TEST_CASE("remesh refuses two outputs naming the same file before the run, and may write over IN", "[cli]") {
+  TempDir dir;
+  const std::string in = dir.file("sphere.obj"), out = dir.file("out.obj");
+  write_obj(remesh::test::make_icosphere(1), in);
+  fs::create_directory(dir.file("sub"));
+  auto refused = [&](const std::vector<std::string>& outputs, const std::string& mentions) {
+    std::vector<std::string> args = {in, "--emin", "0.2", "--emax", "0.3", "--iterations", "1"};
+    args.insert(args.end(), outputs.begin(), outputs.end());
+    const ProcessResult r = remesh_cli(args);
+    INFO("stderr: " << r.err);
+    CHECK(r.exit_code == 2);
+    CHECK(lines(r.err) == 1);
+    CHECK(r.err.find(mentions) != std::string::npos);
+  };
+
+  // OUT and --dual, however spelled: nothing is written.
+  refused({out, "--dual", out}, "--dual names the same file as OUT: " + out);
+  refused({out, "--dual", (dir.path / "." / "out.obj").string()}, "--dual names the same file as OUT");
+  refused({out, "--dual", (dir.path / "sub" / ".." / "out.obj").string()}, "--dual names the same file as OUT");
+  refused({(dir.path / "sub" / ".." / "out.obj").string(), "--dual", out, "--stats", dir.file("s.csv")},
+          "--dual names the same file as OUT");
+  CHECK(!fs::exists(out));
+  CHECK(!fs::exists(dir.file("s.csv")));
+
+  // --stats and OUT through a symbolic link, to a file not written yet and to one written before.
+  fs::create_symlink(out, dir.file("link.csv"));
+  refused({out, "--stats", dir.file("link.csv")}, "--stats names the same file as OUT");
+  CHECK(!fs::exists(out));
+  std::ofstream(out) << "earlier\n";
+  refused({out, "--stats", dir.file("link.csv")}, "--stats names the same file as OUT");
+  CHECK(read_text(out) == "earlier\n");
+
+  // --stats and --dual through a hard link.
+  const std::string dual = dir.file("dual.obj");
+  std::ofstream(dual) << "earlier dual\n";
+  fs::create_hard_link(dual, dir.file("hard.json"));
+  refused({dir.file("other.obj"), "--dual", dual, "--stats", dir.file("hard.json")},
+          "--stats names the same file as --dual");
+  CHECK(read_text(dual) == "earlier dual\n");
+  CHECK(!fs::exists(dir.file("other.obj")));
+
+  // OUT over IN stays allowed: IN is read before anything is written.
+  const std::string both = dir.file("both.obj");
+  fs::copy_file(in, both);
+  const ProcessResult r = remesh_cli({both, (dir.path / "." / "both.obj").string(), "--emin", "0.2", "--emax", "0.3",
+                                      "--iterations", "2", "--quiet"});
+  INFO(r.err);
+  REQUIRE(r.exit_code == 0);
+  CHECK(info_json(both).at("faces") > 80);  // refined: the icosphere's 80 faces have edges over 0.3
+}
+
 TEST_CASE("a job over --max-faces is refused with exit 3", "[cli]") {
   TempDir dir;
   write_obj(remesh::test::make_icosphere(2), dir.file("sphere.obj"));
