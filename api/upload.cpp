@@ -101,6 +101,33 @@ std::string safe_stem(std::string_view filename) {
   return out.empty() ? "mesh" : out;
 }
 
+std::string content_disposition(std::string_view disposition, std::string_view filename, std::string_view suffix) {
+  const std::string ascii = safe_stem(filename);
+  std::string out = std::string(disposition) + "; filename=\"" + ascii + std::string(suffix) + "\"";
+  auto slash = filename.find_last_of("/\\");
+  if (slash != std::string_view::npos) filename.remove_prefix(slash + 1);
+  auto dot = filename.find_last_of('.');
+  if (dot != std::string_view::npos && dot > 0) filename = filename.substr(0, dot);
+  std::string stem = utf8_prefix(filename, 80);
+  while (!stem.empty() && stem.front() == '.') stem.erase(stem.begin());
+  if (stem.empty() || stem == ascii) return out;
+  // RFC 8187 attr-char: ALPHA / DIGIT / "!#$&+-.^_`|~"; every other byte percent-encoded.
+  static constexpr std::string_view kAttr = "!#$&+-.^_`|~";
+  static constexpr char kHex[] = "0123456789ABCDEF";
+  out += "; filename*=UTF-8''";
+  for (char ch : stem + std::string(suffix)) {
+    const auto c = static_cast<unsigned char>(ch);
+    if (std::isalnum(c) || kAttr.find(ch) != std::string_view::npos) {
+      out += ch;
+    } else {
+      out += '%';
+      out += kHex[c >> 4];
+      out += kHex[c & 15];
+    }
+  }
+  return out;
+}
+
 PreparedJob prepare_job(std::string_view bytes, std::string_view filename, std::optional<Format> format,
                         ParsedParams params, const UploadLimits& limits) {
   std::vector<FieldError> errors = validate_params(params, limits.max_iterations);

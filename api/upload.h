@@ -29,6 +29,12 @@ std::optional<Format> resolve_format(std::string_view format_param, std::string_
 /// [A-Za-z0-9._-] kept (others become '_'), at most 80 characters; "mesh" when nothing is left.
 std::string safe_stem(std::string_view filename);
 
+/// A Content-Disposition value for a download named after an upload: `disposition` ("attachment",
+/// "inline"), filename="<safe_stem><suffix>", and when the stem had characters safe_stem replaced,
+/// also filename*=UTF-8''<the stem (utf8_prefix, 80 bytes) and suffix percent-encoded> (RFC 6266,
+/// RFC 8187), which browsers prefer: "été.off" downloads as "été-remeshed.obj", not "__t_-...".
+std::string content_disposition(std::string_view disposition, std::string_view filename, std::string_view suffix);
+
 /// `text` as valid UTF-8 of at most `max_bytes` bytes: each byte that does not begin a valid
 /// sequence becomes U+FFFD, and the text is cut between characters (a job's filename is shown and
 /// stored as JSON, which must be UTF-8: "%FF.obj" used to give a 500).

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <atomic>
 #include <charconv>
+#include <cctype>
 #include <cmath>
 #include <chrono>
 #include <regex>
@@ -36,7 +37,12 @@ namespace {
 /// the post-routing handler, while a provider's ranges it serves as asked, unclipped ("bytes=0-300000"
 /// of a 10 KB file sent 300 001 bytes, most from the heap past the file). Such a range of a text
 /// file may then be compressed (the range of the uncompressed bytes, br-encoded).
+/// The size of the bytes this thread last answered with send_bytes (0: none since the request began),
+/// for the Content-Range of a 416 (RFC 9110 15.5.17: "bytes */size").
+thread_local std::size_t t_answer_size = 0;
+
 void send_bytes(const httplib::Request& req, httplib::Response& res, std::string bytes, const std::string& mime) {
+  t_answer_size = bytes.size();
   if (!req.ranges.empty()) {
     res.set_content(std::move(bytes), mime);
     return;
@@ -53,6 +59,14 @@ void send_bytes(const httplib::Request& req, httplib::Response& res, std::string
 constexpr const char* kPrefix = "/api/v1";
 constexpr std::size_t kMiB = 1024 * 1024;
 constexpr std::size_t kMaxParamsBytes = 64 * 1024;
+/// The most header bytes (names, values and their separators) a request may carry.
+constexpr std::size_t kMaxHeaderBytes = 64 * 1024;
+
+std::size_t header_bytes(const httplib::Request& req) {
+  std::size_t bytes = 0;
+  for (const auto& [name, value] : req.headers) bytes += name.size() + value.size() + 4;  // ": " and CRLF
+  return bytes;
+}
 /// How much of an over-limit upload is read (and dropped) so the client can read the 413; beyond
 /// it the connection is closed.
 constexpr std::size_t kDrainBytes = 64 * kMiB;
@@ -110,6 +124,39 @@ bool constant_time_equal(const std::string& a, const std::string& b) {
 }
 
 /// Query parameters as a map (first value of each), minus the ones that are not job parameters.
+/// Keys of the query given more than once ("?emin=1&emin=2": which one did the client mean?).
+std::vector<FieldError> repeated_query_keys(const httplib::Request& req) {
+  std::vector<FieldError> errors;
+  for (auto it = req.params.begin(); it != req.params.end(); it = req.params.upper_bound(it->first)) {
+    const std::size_t n = req.params.count(it->first);
+    if (n > 1) errors.push_back({it->first.substr(0, 64), "was given " + std::to_string(n) + " times; give it once"});
+  }
+  return errors;
+}
+
+/// Keys that an object of the JSON text holds more than once ({"emin": 1, "emin": 2}: nlohmann
+/// keeps the last silently). Empty for text that does not parse.
+std::vector<std::string> repeated_json_keys(const std::string& text) {
+  std::vector<std::vector<std::string>> open;  // the keys of each object being read
+  std::vector<std::string> repeated;
+  auto seen = [&](int, json::parse_event_t event, json& parsed) {
+    if (event == json::parse_event_t::object_start) open.emplace_back();
+    else if (event == json::parse_event_t::object_end && !open.empty()) open.pop_back();
+    else if (event == json::parse_event_t::key && !open.empty()) {
+      const std::string key = parsed.get<std::string>();
+      std::vector<std::string>& keys = open.back();
+      if (std::find(keys.begin(), keys.end(), key) != keys.end()) {
+        if (std::find(repeated.begin(), repeated.end(), key) == repeated.end()) repeated.push_back(key);
+      } else {
+        keys.push_back(key);
+      }
+    }
+    return true;
+  };
+  if (json::parse(text, seen, false).is_discarded()) return {};
+  return repeated;
+}
+
 std::map<std::string, std::string> query_params(const httplib::Request& req) {
   std::map<std::string, std::string> out;
   for (const auto& [k, v] : req.params) out.emplace(k, v);
@@ -212,7 +259,12 @@ void HttpServer::Impl::cors_headers(httplib::Response& res) const {
 bool HttpServer::Impl::authorized(const httplib::Request& req) const {
   if (options.token.empty()) return true;
   std::string auth = req.get_header_value("Authorization");
-  if (auth.rfind("Bearer ", 0) == 0 && constant_time_equal(auth.substr(7), options.token)) return true;
+  // The scheme is case-insensitive (RFC 9110 11.1): "bearer" and "BEARER" too.
+  const bool bearer = auth.size() > 7 && auth[6] == ' ' &&
+                      std::equal(auth.begin(), auth.begin() + 6, "bearer", [](char a, char b) {
+                        return std::tolower(static_cast<unsigned char>(a)) == b;
+                      });
+  if (bearer && constant_time_equal(auth.substr(7), options.token)) return true;
   // EventSource and download links cannot set headers: the token may come as a query parameter.
   if (req.has_param("access_token") && constant_time_equal(req.get_param_value("access_token"), options.token))
     return true;
@@ -238,6 +290,23 @@ void HttpServer::Impl::setup() {
   server.set_pre_routing_handler([this](const httplib::Request& req, httplib::Response& res) {
     t_request_start = std::chrono::steady_clock::now();
     t_problem = {};
+    t_answer_size = 0;
+    // Both framings: RFC 9112 6.3 has a server refuse the message and close the connection (a
+    // proxy in front may have read it the other way: the shape of request smuggling).
+    if (req.has_header("Content-Length") && req.has_header("Transfer-Encoding")) {
+      res.set_header("Connection", "close");
+      send_problem(res, 400, "malformed request: both Content-Length and Transfer-Encoding are set");
+      return httplib::Server::HandlerResponse::Handled;
+    }
+    // cpp-httplib 0.11 limits each header line (8 KiB) but not their number; the whole block has
+    // been read by now, so this bounds what the request costs from here on, and says why.
+    if (const std::size_t bytes = header_bytes(req); bytes > kMaxHeaderBytes) {
+      res.set_header("Connection", "close");
+      send_problem(res, 431, "the request's headers take " + std::to_string(bytes) + " bytes; at most " +
+                                 std::to_string(kMaxHeaderBytes) + " are accepted");
+      jobs.trim_memory_soon();
+      return httplib::Server::HandlerResponse::Handled;
+    }
     // One byte range at most. cpp-httplib 0.11 builds the multipart answer to every range asked for
     // in memory, overlapping or not: "bytes=0-,0-,..." (2 000 ranges in a 6 KB header) made a 2 GB
     // answer of a 1 MB result. RFC 9110 14.2 lets a server ignore Range: a request for several gets
@@ -256,6 +325,13 @@ void HttpServer::Impl::setup() {
       send_problem(res, 401, "this server requires 'Authorization: Bearer <token>'");
       return httplib::Server::HandlerResponse::Handled;
     }
+    if (req.path.rfind("/api/", 0) == 0) {
+      if (auto errors = repeated_query_keys(req); !errors.empty()) {
+        if (has_body(req)) res.set_header("Connection", "close");  // its body is not read
+        send_problem(res, 422, "invalid query: see errors", errors);
+        return httplib::Server::HandlerResponse::Handled;
+      }
+    }
     return httplib::Server::HandlerResponse::Unhandled;
   });
   server.set_post_routing_handler([this](const httplib::Request& req, httplib::Response& res) {
@@ -268,13 +344,17 @@ void HttpServer::Impl::setup() {
     // An error is answered whole, whatever byte ranges the request asked for (see t_problem). A
     // range past the end of an answer: cpp-httplib 0.11 clears the body, sets 416 and a
     // Content-Length of 0 after the error handler has run; say which range, as every error does.
+    // A handler's error keeps its status: cpp-httplib 0.11 turns it into a 416 when the range
+    // starts past the end of the error's body ("Range: bytes=999999-" on a 404).
     if (res.status >= 400 && (!req.ranges.empty() || res.status == 416)) {
-      if (t_problem.status == res.status) {
+      res.headers.erase("Content-Range");
+      if (t_problem.status >= 400) {
+        res.status = t_problem.status;
         res.set_content(t_problem.body, "application/problem+json");
       } else if (res.status == 416) {
         send_problem(res, 416, range_problem(req));
+        if (t_answer_size > 0) res.set_header("Content-Range", "bytes */" + std::to_string(t_answer_size));
       }
-      res.headers.erase("Content-Range");
       res.headers.erase("Content-Length");
       res.set_header("Content-Length", std::to_string(res.body.size()));
     }
@@ -488,7 +568,19 @@ void HttpServer::Impl::post_job(const httplib::Request& req, httplib::Response& 
     json j = json::parse(params_text, nullptr, false);
     if (params_too_big) errors.push_back({"params", "is larger than 64 KiB"});
     else if (j.is_discarded()) errors.push_back({"params", "is not valid JSON"});
+    else if (!j.is_object()) errors.push_back({"params", "must be a JSON object of the job's parameters"});
     else parsed = remesh::params_from_json(j);
+    for (const std::string& key : repeated_json_keys(params_text))
+      errors.push_back({"params." + key.substr(0, 64), "is given more than once; give it once"});
+    // The job's parameters come from one place: with a params part, the query holds none.
+    const auto& names = remesh::param_names();
+    for (const auto& [key, value] : req.params) {
+      if (key == "format" || key == "filename" || key == "access_token") continue;
+      const bool param = std::find(names.begin(), names.end(), key) != names.end();
+      errors.push_back({key.substr(0, 64), param ? "is in the query and there is a params part: give every parameter in "
+                                                   "the params part"
+                                                 : "unknown parameter"});
+    }
   } else {
     parsed = remesh::params_from_query(query_params(req), {"format", "filename", "access_token"});
   }
@@ -719,8 +811,9 @@ void HttpServer::Impl::result(const httplib::Request& req, httplib::Response& re
     return;
   }
   std::string bytes = read_file(path);
-  std::string name = remesh::api::safe_stem(rec->filename) + "-" + mesh + "." + format;
-  res.set_header("Content-Disposition", "attachment; filename=\"" + name + "\"");
+  res.set_header("Content-Disposition",
+                 remesh::api::content_disposition("attachment", rec->filename, "-" + mesh + "." + format));
+  res.set_header("Accept-Ranges", "bytes");
   auto f = remesh::parse_format(format);
   res.status = 200;
   send_bytes(req, res, std::move(bytes), f ? std::string(remesh::mime_type(*f)) : "application/octet-stream");
@@ -740,8 +833,7 @@ void HttpServer::Impl::stats(const httplib::Request& req, httplib::Response& res
     return;
   }
   if (format == "csv") {
-    res.set_header("Content-Disposition",
-                   "inline; filename=\"" + remesh::api::safe_stem(rec->filename) + "-stats.csv\"");
+    res.set_header("Content-Disposition", remesh::api::content_disposition("inline", rec->filename, "-stats.csv"));
     res.set_content(remesh::stats_to_csv(*rows), "text/csv; charset=utf-8");
     return;
   }

@@ -460,12 +460,29 @@ Gauges JobManager::gauges() const {
   return g;
 }
 
+void JobManager::trim_memory_soon() {
+  {
+    std::lock_guard lock(mutex_);
+    trim_wanted_ = true;
+  }
+  janitor_wake_.notify_all();
+}
+
 void JobManager::janitor_loop() {
   double interval = config_.job_ttl_seconds > 0 ? std::clamp(config_.job_ttl_seconds / 4, 1.0, 60.0) : 60.0;
   std::unique_lock lock(mutex_);
   while (!stopping_) {
-    janitor_wake_.wait_for(lock, secs(interval));
+    if (!trim_wanted_) janitor_wake_.wait_for(lock, secs(interval));  // a finished job wakes it too
     if (stopping_) break;
+    if (std::exchange(trim_wanted_, false)) {
+      // After the request is answered and its headers freed (a moment after the call).
+      janitor_wake_.wait_for(lock, secs(0.2), [this] { return stopping_; });
+      if (stopping_) break;
+#ifdef __GLIBC__
+      malloc_trim(0);
+#endif
+      continue;
+    }
     lock.unlock();
     try {
       expire();

@@ -88,6 +88,10 @@ class JobManager {
                                           std::optional<remesh::api::JobState>& state_before) const;
   /// Events after `cursor`; waits up to `timeout_seconds` when there are none yet.
   Batch poll(const std::string& id, std::size_t cursor, double timeout_seconds) const;
+  /// Has the janitor hand freed memory back to the system in a moment (malloc_trim): after a
+  /// request whose headers took megabytes, which cpp-httplib read whole and the request's end
+  /// frees, but to malloc only.
+  void trim_memory_soon();
   /// Wakes every waiting poll (shutdown).
   void wake_all();
 
@@ -116,6 +120,7 @@ class JobManager {
   bool is_suspect(const std::string& id) const;
   void run(const std::string& id);
   void janitor_loop();
+  bool trim_wanted_ = false;  ///< trim_memory_soon() was called (under mutex_)
   void expire();
   /// Sets a state (and the event), persists it, logs it. Caller holds mutex_.
   void transition(Job& job, remesh::api::JobState state);

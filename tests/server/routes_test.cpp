@@ -619,3 +619,116 @@ TEST_CASE("remeshd: parameters and names that once crashed the service or gave 5
   CHECK(problem["title"] == "Range Not Satisfiable");
   CHECK(problem["detail"].get<std::string>().find("'bytes=zz'") != std::string::npos);
 }
+
+TEST_CASE("remeshd: requests a black-box review found answered wrongly", "[server]") {
+  TempDir tmp;
+  Daemon d(tmp.path / "data", {"--workers", "1"});
+  auto c = d.client();
+  auto r = submit_raw(c, sphere_obj(1), "emin=0.3&emax=0.5&iterations=2&filename=%C3%A9t%C3%A9%20ball.obj",
+                      "model/obj");
+  REQUIRE(r);
+  REQUIRE(r->status == 202);
+  const std::string id = body_of(r)["id"];
+  REQUIRE(wait_final(c, id)["state"] == "succeeded");
+  const std::string result = "/api/v1/jobs/" + id + "/result?mesh=remeshed&format=obj";
+  const auto whole = c.Get(result.c_str());
+  REQUIRE(whole);
+  REQUIRE(whole->status == 200);
+
+  // A range past the end of an error's body keeps the error's status (it was a 416).
+  const httplib::Headers past_end = {{"Range", "bytes=999999-"}};
+  for (const auto& [path, status] : {std::pair{std::string("/api/v1/jobs/00000000000000000000000000000000"), 404},
+                                     {"/api/v1/jobs/" + id + "/result?format=xyz", 422}}) {
+    CAPTURE(path);
+    auto e = c.Get(path.c_str(), past_end);
+    REQUIRE(e);
+    CHECK(e->status == status);
+    CHECK(nlohmann::json::parse(e->body)["status"] == status);
+    CHECK_FALSE(e->has_header("Content-Range"));
+  }
+  // A real 416 says the length (RFC 9110 15.5.17), and downloads announce ranges on GET too.
+  auto unsatisfiable = c.Get(result.c_str(), past_end);
+  REQUIRE(unsatisfiable);
+  CHECK(unsatisfiable->status == 416);
+  CHECK(unsatisfiable->get_header_value("Content-Range") == "bytes */" + std::to_string(whole->body.size()));
+  CHECK(whole->get_header_value("Accept-Ranges") == "bytes");
+  // A name with characters the plain filename cannot carry keeps them in filename* (RFC 6266).
+  // Read raw: cpp-httplib's client percent-decodes header values.
+  const std::string raw = raw_exchange(d.port(), "GET " + result + " HTTP/1.1\r\nHost: x\r\nConnection: close\r\n\r\n", 10);
+  CHECK(raw.find("\r\nContent-Disposition: attachment; filename=\"__t___ball-remeshed.obj\"; "
+                 "filename*=UTF-8''%C3%A9t%C3%A9%20ball-remeshed.obj\r\n") != std::string::npos);
+
+  // A repeated query key is refused, naming it, on every route (first or last value won silently).
+  for (const auto& [path, field] : {std::pair{std::string("/api/v1/jobs?limit=2&limit=3"), "limit"},
+                                    {"/api/v1/jobs/" + id + "/result?format=obj&format=stl", "format"}}) {
+    CAPTURE(path);
+    auto twice = c.Get(path.c_str());
+    REQUIRE(twice);
+    CHECK(twice->status == 422);
+    CHECK(error_fields(twice) == std::set<std::string>{field});
+  }
+  auto posted_twice = submit_raw(c, sphere_obj(1), "emin=0.3&emin=0.2&emax=0.5");
+  REQUIRE(posted_twice);
+  CHECK(posted_twice->status == 422);
+  CHECK(error_fields(posted_twice) == std::set<std::string>{"emin"});
+
+  // Multipart: a key twice in the params part, or job parameters in the query beside a params part
+  // (the query was dropped without a word), are refused, each named.
+  auto multipart = [&](const std::string& params, const std::string& query) {
+    httplib::MultipartFormDataItems items = {{"mesh", sphere_obj(1), "ball.obj", "application/octet-stream"},
+                                             {"params", params, "", "application/json"}};
+    return c.Post(("/api/v1/jobs" + query).c_str(), items);
+  };
+  auto dup = multipart(R"({"emin":0.3,"emax":0.5,"emin":0.2})", "");
+  REQUIRE(dup);
+  CHECK(dup->status == 422);
+  CHECK(error_fields(dup) == std::set<std::string>{"params.emin"});
+  auto mixed = multipart(R"({"emin":0.3,"emax":0.5,"iterations":2})", "?iterations=99999&bogus=1");
+  REQUIRE(mixed);
+  CHECK(mixed->status == 422);
+  CHECK(error_fields(mixed) == std::set<std::string>{"iterations", "bogus"});
+  auto not_object = multipart(R"("emin")", "");
+  REQUIRE(not_object);
+  CHECK(not_object->status == 422);
+  CHECK(body_of(not_object)["errors"][0]["message"].get<std::string>().find("must be a JSON object") !=
+        std::string::npos);
+  auto fine = multipart(R"({"emin":0.3,"emax":0.5,"iterations":2})", "?filename=b.obj");
+  REQUIRE(fine);
+  CHECK(fine->status == 202);
+
+  // Both Content-Length and Transfer-Encoding: 400, and the connection is closed (RFC 9112 6.3).
+  const std::string smuggled = raw_exchange(d.port(),
+                                            "POST /api/v1/jobs?emin=1&emax=2 HTTP/1.1\r\nHost: x\r\nContent-Length: 3\r\n"
+                                            "Transfer-Encoding: chunked\r\n\r\n0\r\n\r\nGET /healthz HTTP/1.1\r\nHost: x\r\n\r\n",
+                                            10);
+  INFO(smuggled);
+  CHECK(smuggled.rfind("HTTP/1.1 400", 0) == 0);
+  CHECK(smuggled.find("both Content-Length and Transfer-Encoding") != std::string::npos);
+  CHECK(smuggled.find("HTTP/1.1 200") == std::string::npos);  // the second request is not served
+
+  // Headers of more than 64 KiB in all (each line under httplib's 8 KiB): 431, and the daemon serves on.
+  std::string flood = "GET /healthz HTTP/1.1\r\nHost: x\r\n";
+  for (int i = 0; i < 20; ++i) flood += "X-Fill-" + std::to_string(i) + ": " + std::string(8000, 'a') + "\r\n";
+  const std::string refused = raw_exchange(d.port(), flood + "\r\n", 10);
+  CHECK(refused.rfind("HTTP/1.1 431", 0) == 0);
+  CHECK(refused.find("at most 65536 are accepted") != std::string::npos);
+  auto health = c.Get("/healthz");
+  REQUIRE(health);
+  CHECK(health->status == 200);
+}
+
+TEST_CASE("remeshd: the bearer scheme is matched without regard to case", "[server]") {
+  TempDir tmp;
+  Daemon d(tmp.path / "data", {"--token", "tk"});
+  auto c = d.client();
+  for (const std::string scheme : {"Bearer", "bearer", "BEARER"}) {
+    auto r = c.Get("/api/v1/jobs", {{"Authorization", scheme + " tk"}});
+    REQUIRE(r);
+    CHECK(r->status == 200);
+  }
+  for (const std::string wrong : {"Bearer tK", "Basic tk", "Bearertk", "bearer"}) {
+    auto r = c.Get("/api/v1/jobs", {{"Authorization", wrong}});
+    REQUIRE(r);
+    CHECK(r->status == 401);
+  }
+}
