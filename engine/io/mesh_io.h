@@ -31,7 +31,8 @@
 ///     "unreferenced_vertices_removed".
 ///   STL corners are welded by exact position while reading (STL has no indices): not a repair.
 ///   LimitError when ReadOptions::max_faces is exceeded (checked on header counts before
-///   allocating, and again after triangulation).
+///   allocating, and again after triangulation). Header counts the file's bytes cannot hold are a
+///   MeshError first, limit or not: a small file claiming a billion faces is malformed, not too large.
 
 #include <cstdint>
 #include <optional>

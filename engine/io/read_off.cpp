@@ -36,13 +36,14 @@ std::int64_t parse_count(std::string_view& rest, std::size_t line, const char* w
 
 void check_counts(std::int64_t nv, std::int64_t nf, std::size_t bytes_left, std::size_t min_v,
                   std::size_t min_f, const ReadOptions& options) {
-  check_face_limit(static_cast<std::uint64_t>(nf), options, "OFF");
-  // Each vertex and face needs some bytes: refuse absurd counts before allocating anything.
+  // Each vertex and face needs some bytes: refuse absurd counts before allocating anything, and
+  // before the face limit, so that a small file claiming a billion faces is malformed, not too large.
   if (static_cast<std::uint64_t>(nv) > bytes_left / min_v ||
       static_cast<std::uint64_t>(nf) > bytes_left / min_f ||
       static_cast<std::uint64_t>(nv) * min_v + static_cast<std::uint64_t>(nf) * min_f > bytes_left + 2)
     fail("OFF header claims " + std::to_string(nv) + " vertices and " + std::to_string(nf) +
          " faces, but only " + std::to_string(bytes_left) + " bytes follow (file truncated?)");
+  check_face_limit(static_cast<std::uint64_t>(nf), options, "OFF");
 }
 
 RawSoup read_off_binary(std::string_view bytes, std::size_t data_start, const ReadOptions& options) {

@@ -261,7 +261,8 @@ RawSoup read_ply(std::string_view bytes, const ReadOptions& options) {
   const Header h = parse_header(bytes);
   const Layout layout = find_layout(h);
   const bool binary = h.encoding != Encoding::Ascii;
-  check_face_limit(h.elements[static_cast<std::size_t>(layout.face_element)].count, options, "PLY");
+  // Counts the bytes cannot hold are checked before the face limit: a small file claiming a billion
+  // faces is malformed (truncated or not PLY), not too large.
   {
     const std::uint64_t left = bytes.size() - h.data_start;
     std::uint64_t need = 0;
@@ -273,6 +274,7 @@ RawSoup read_ply(std::string_view bytes, const ReadOptions& options) {
       need += e.count * per;
     }
   }
+  check_face_limit(h.elements[static_cast<std::size_t>(layout.face_element)].count, options, "PLY");
   RawSoup soup;
   BodyReader body(bytes, h);
   for (std::size_t e = 0; e < h.elements.size(); ++e) {

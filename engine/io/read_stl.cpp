@@ -52,10 +52,13 @@ RawSoup read_binary_stl(std::string_view bytes, const ReadOptions& options) {
   if (bytes.size() < 84) fail("binary STL: file has " + std::to_string(bytes.size()) + " bytes, less than the 84-byte header");
   ByteReader r(bytes, 80);
   const std::uint64_t n = r.read<std::uint32_t>(false);
-  check_face_limit(n, options, "STL");
+  // The size first, the limit after (both before reserving): text read as a binary STL (an OFF
+  // under an .stl name) gives a count in the hundreds of millions, and "more faces than the limit"
+  // (HTTP 413) would call a malformed 42 KB file too large.
   if (84 + 50 * n > bytes.size())
     fail("binary STL: header says " + std::to_string(n) + " triangles (" + std::to_string(84 + 50 * n) +
          " bytes) but the file has " + std::to_string(bytes.size()) + " bytes (truncated?)");
+  check_face_limit(n, options, "STL");
   RawSoup soup;
   soup.points.reserve(n);
   soup.indices.reserve(3 * n);

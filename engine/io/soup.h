@@ -28,7 +28,8 @@ struct RawSoup {
 };
 
 /// Per-format readers. Each throws MeshError naming the problem and where, LimitError when the
-/// face count exceeds options.max_faces (checked before allocating).
+/// face count exceeds options.max_faces (checked before allocating, once the declared counts are
+/// known to fit the file's size: counts that cannot are a MeshError).
 RawSoup read_obj(std::string_view bytes, const ReadOptions& options);
 RawSoup read_off(std::string_view bytes, const ReadOptions& options);
 RawSoup read_ply(std::string_view bytes, const ReadOptions& options);

@@ -1,6 +1,9 @@
 // Validation and repair: each malformed case gives its specific, located error or counted repair.
 #include <catch2/catch.hpp>
 
+#include <cstdint>
+#include <random>
+
 #include "io/mesh_io.h"
 #include "io/summary.h"
 #include "io_test_util.h"
@@ -8,10 +11,53 @@
 
 using namespace remesh;
 using Catch::Contains;
+using Catch::StartsWith;
 
 namespace {
 
 LoadedMesh read(const std::string& bytes, ReadOptions o = {}) { return read_mesh(bytes, o); }
+
+/// What reading throws, named by its type ("MeshError: ...", "LimitError: ..."); "" if it reads.
+/// LimitError is not a MeshError: the type decides the HTTP status (413 or 422).
+std::string error_of(const std::string& bytes, const ReadOptions& o) {
+  try {
+    read_mesh(bytes, o);
+  } catch (const LimitError& e) {
+    return std::string("LimitError: ") + e.what();
+  } catch (const MeshError& e) {
+    return std::string("MeshError: ") + e.what();
+  }
+  return "";
+}
+
+/// A GLB tetrahedron: 4 positions, then an index accessor of `index_count` unsigned shorts in a
+/// bufferView that holds its 12.
+std::string tetra_glb(std::size_t index_count) {
+  std::string bin;
+  for (float v : {0.f, 0.f, 0.f, 1.f, 0.f, 0.f, 0.f, 1.f, 0.f, 0.f, 0.f, 1.f})
+    bin.append(reinterpret_cast<const char*>(&v), 4);
+  for (std::uint16_t i : {0, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3}) bin.append(reinterpret_cast<const char*>(&i), 2);
+  std::string json = R"({"asset":{"version":"2.0"},"scene":0,"scenes":[{"nodes":[0]}],"nodes":[{"mesh":0}],
+    "meshes":[{"primitives":[{"attributes":{"POSITION":0},"indices":1}]}],
+    "buffers":[{"byteLength":72}],
+    "bufferViews":[{"buffer":0,"byteLength":48},{"buffer":0,"byteOffset":48,"byteLength":24}],
+    "accessors":[{"bufferView":0,"componentType":5126,"count":4,"type":"VEC3"},
+                 {"bufferView":1,"componentType":5123,"count":)" + std::to_string(index_count) +
+                     R"(,"type":"SCALAR"}]})";
+  while (json.size() % 4) json.push_back(' ');
+  std::string out = "glTF";
+  auto put32 = [&](std::size_t v) {
+    const auto u = static_cast<std::uint32_t>(v);
+    out.append(reinterpret_cast<const char*>(&u), 4);
+  };
+  put32(2);
+  put32(12 + 8 + json.size() + 8 + bin.size());
+  put32(json.size());
+  out += "JSON" + json;
+  put32(bin.size());
+  out += std::string("BIN\0", 4) + bin;
+  return out;
+}
 
 const Repair* find_repair(const LoadedMesh& m, const std::string& kind) {
   for (const Repair& r : m.repairs)
@@ -262,12 +308,11 @@ TEST_CASE("max_faces is enforced before allocating, with LimitError") {
   ReadOptions o;
   o.max_faces = 3;
   CHECK_THROWS_AS(read(kTetraVerts + kTetraFaces, o), LimitError);
-  CHECK_THROWS_AS(read("OFF\n4 4000000000 0\n", o), LimitError);
-  CHECK_THROWS_AS(read("ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
-                       "property float z\nelement face 99999999\nproperty list uchar int vertex_indices\nend_header\n", o),
+  // Header counts over the limit that the bytes can hold (the same tetrahedron).
+  CHECK_THROWS_AS(read("OFF\n4 4 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 1 2 3\n3 0 3 2\n", o),
                   LimitError);
-  std::string stl(84, '\0');
-  stl[80] = '\x10';  // 16 triangles claimed
+  std::string stl(84 + 50 * 16, '\0');
+  stl[80] = '\x10';  // 16 triangles claimed, and there
   ReadOptions stl_o = o;
   stl_o.format = Format::Stl;
   CHECK_THROWS_AS(read(stl, stl_o), LimitError);
@@ -292,6 +337,92 @@ TEST_CASE("Headers claiming huge counts are refused without allocating") {
   for (int i = 0; i < 2; ++i) off += std::string("\x7f\xff\xff\xff", 4);
   off += std::string(4, '\0');
   CHECK_THROWS_WITH(read(off), Contains("header claims"));
+}
+
+TEST_CASE("With max_faces set, counts the bytes cannot hold are malformed (MeshError), not over the limit") {
+  // The service sets max_faces and answers LimitError with 413: a 42 KB OFF uploaded as .stl (its
+  // text read as a binary STL's triangle count, 808263728) was called too large, not malformed.
+  ReadOptions o;
+  o.max_faces = 2'000'000;  // remeshd's default
+  auto stl_count = [](const std::string& bytes) {
+    std::uint32_t n = 0;
+    for (int i = 3; i >= 0; --i) n = n << 8 | static_cast<unsigned char>(bytes[80 + static_cast<std::size_t>(i)]);
+    return n;
+  };
+  SECTION("binary STL") {
+    o.format = Format::Stl;
+    const std::string off = write_mesh(test::make_icosphere(3), Format::Off);
+    const std::uint32_t n = stl_count(off);
+    REQUIRE(n > o.max_faces);
+    CHECK_THAT(error_of(off, o), StartsWith("MeshError: binary STL: header says " + std::to_string(n) + " triangles") &&
+                                     Contains("the file has " + std::to_string(off.size()) + " bytes"));
+    std::mt19937 rng(5);
+    std::string noise(5000, '\0');
+    for (char& c : noise) c = static_cast<char>(rng());
+    noise[0] = 'x';  // not "solid"
+    REQUIRE(stl_count(noise) > o.max_faces);
+    CHECK_THAT(error_of(noise, o), StartsWith("MeshError: binary STL: header says " + std::to_string(stl_count(noise))));
+    std::string three(84 + 50 * 3, '\0');  // 3 000 000 triangles claimed, 3 there
+    three.replace(80, 3, "\xc0\xc6\x2d");  // little-endian 0x2dc6c0
+    CHECK_THAT(error_of(three, o), StartsWith("MeshError: binary STL: header says 3000000 triangles") &&
+                                       Contains("the file has 234 bytes"));
+  }
+  SECTION("OFF, ASCII and binary") {
+    CHECK_THAT(error_of("OFF\n999999999 999999999 0\n0 0 0\n", o),
+               StartsWith("MeshError: OFF header claims 999999999 vertices and 999999999 faces") &&
+                   Contains("only 6 bytes follow"));
+    CHECK_THAT(error_of("OFF\n4 4000000000 0\n", o), StartsWith("MeshError: OFF header claims") && Contains("4000000000 faces"));
+    std::string off = "OFF BINARY\n";
+    for (std::uint32_t v : {3u, 100'000'000u, 0u})
+      for (int shift = 24; shift >= 0; shift -= 8) off.push_back(static_cast<char>(v >> shift));
+    off += std::string(36, '\0');  // the 3 vertices
+    CHECK_THAT(error_of(off, o), StartsWith("MeshError: OFF header claims 3 vertices and 100000000 faces"));
+  }
+  SECTION("PLY, ASCII and binary") {
+    const std::string header = "element vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+                               "element face 99999999\nproperty list uchar int vertex_indices\nend_header\n";
+    CHECK_THAT(error_of("ply\nformat ascii 1.0\n" + header + "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n", o),
+               StartsWith("MeshError: PLY header claims 99999999 'face' elements"));
+    std::string body(36, '\0');  // 3 vertices, then one face
+    body += std::string("\x03\0\0\0\0\x01\0\0\0\x02\0\0\0", 13);
+    CHECK_THAT(error_of("ply\nformat binary_little_endian 1.0\n" + header + body, o),
+               StartsWith("MeshError: PLY header claims 99999999 'face' elements"));
+  }
+  SECTION("GLB: an index accessor longer than its bufferView") {
+    // The face limit counts triangles as they are taken from a checked accessor: already in order.
+    CHECK_THAT(error_of(tetra_glb(3'000'000), o), StartsWith("MeshError: glTF:") && Contains("3000000 elements") &&
+                                                      Contains("reaches past the end of its bufferView"));
+  }
+}
+
+TEST_CASE("With max_faces set, a file that holds more faces than the limit is refused with LimitError") {
+  // Every format and variant, with the faces really there: one over the limit is refused, at the
+  // limit it reads.
+  const PolygonSoup soup = to_soup(test::make_icosphere(3));
+  const std::size_t faces = soup.offsets.size() - 1;
+  for (const test::SampleFile& file : test::sample_files(soup)) {
+    INFO(file.name);
+    ReadOptions o;
+    o.format = file.format;
+    o.max_faces = faces - 1;
+    CHECK_THAT(error_of(file.bytes, o), StartsWith("LimitError: ") && Contains(std::to_string(faces - 1) + " faces"));
+    o.max_faces = faces;
+    CHECK(error_of(file.bytes, o).empty());
+  }
+  // A binary STL of 2001 (degenerate) triangles, its size exactly 84 + 50 n: over the limit before
+  // anything is read.
+  std::string stl(84 + 50 * 2001, '\0');
+  stl.replace(80, 2, "\xd1\x07");  // little-endian 0x07d1
+  ReadOptions o;
+  o.format = Format::Stl;
+  o.max_faces = 2000;
+  CHECK(error_of(stl, o) == "LimitError: STL has more than 2000 faces (the limit); found at least 2001");
+  // glTF counts triangles as it takes them from checked accessors.
+  ReadOptions glb_o;
+  glb_o.max_faces = 4;
+  CHECK(error_of(tetra_glb(12), glb_o).empty());  // the helper's GLB is a closed tetrahedron
+  glb_o.max_faces = 3;
+  CHECK_THAT(error_of(tetra_glb(12), glb_o), StartsWith("LimitError: glTF has more than 3 faces"));
 }
 
 TEST_CASE("Malformed text names the line") {
