@@ -116,8 +116,11 @@ TEST_CASE("job document: fields, links only when succeeded, round trip", "[api][
   CHECK(doc["timings"]["queued_seconds"] == Approx(1.0));
   CHECK(doc["timings"]["run_seconds"] == Approx(3.0));
   REQUIRE(doc["links"].contains("results"));
-  CHECK(doc["links"]["results"]["remeshed"].size() == 5);
+  CHECK(doc["links"]["results"]["remeshed"].size() == 6);  // obj glb ply off stl lammps
+  CHECK(doc["links"]["results"]["dual"].size() == 6);      // obj glb ply off xyz lammps
   CHECK(doc["links"]["results"]["dual"]["xyz"] == "/api/v1/jobs/" + r.id + "/result?mesh=dual&format=xyz");
+  CHECK(doc["links"]["results"]["remeshed"]["lammps"] ==
+        "/api/v1/jobs/" + r.id + "/result?mesh=remeshed&format=lammps");
 
   JobRecord back = job_from_json(doc);
   CHECK(back.id == r.id);
