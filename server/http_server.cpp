@@ -30,6 +30,10 @@ using remesh::api::make_problem;
 
 namespace {
 
+/// The size of the bytes this thread last answered with send_bytes (0: none since the request began),
+/// for the Content-Range of a 416 (RFC 9110 15.5.17: "bytes */size").
+thread_local std::size_t t_answer_size = 0;
+
 /// A file's bytes as the answer, from a content provider: httplib 0.11.4 brotli-compresses every
 /// set_content() body at its slowest setting when the client accepts br (browsers always do):
 /// seconds for three.js or a big OBJ; a content provider is never compressed. But a request for
@@ -37,10 +41,6 @@ namespace {
 /// the post-routing handler, while a provider's ranges it serves as asked, unclipped ("bytes=0-300000"
 /// of a 10 KB file sent 300 001 bytes, most from the heap past the file). Such a range of a text
 /// file may then be compressed (the range of the uncompressed bytes, br-encoded).
-/// The size of the bytes this thread last answered with send_bytes (0: none since the request began),
-/// for the Content-Range of a 416 (RFC 9110 15.5.17: "bytes */size").
-thread_local std::size_t t_answer_size = 0;
-
 void send_bytes(const httplib::Request& req, httplib::Response& res, std::string bytes, const std::string& mime) {
   t_answer_size = bytes.size();
   if (!req.ranges.empty()) {
@@ -123,7 +123,6 @@ bool constant_time_equal(const std::string& a, const std::string& b) {
   return diff == 0;
 }
 
-/// Query parameters as a map (first value of each), minus the ones that are not job parameters.
 /// Keys of the query given more than once ("?emin=1&emin=2": which one did the client mean?).
 std::vector<FieldError> repeated_query_keys(const httplib::Request& req) {
   std::vector<FieldError> errors;
@@ -157,6 +156,7 @@ std::vector<std::string> repeated_json_keys(const std::string& text) {
   return repeated;
 }
 
+/// Query parameters as a map (first value of each), minus the ones that are not job parameters.
 std::map<std::string, std::string> query_params(const httplib::Request& req) {
   std::map<std::string, std::string> out;
   for (const auto& [k, v] : req.params) out.emplace(k, v);
