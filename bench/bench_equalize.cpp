@@ -236,6 +236,11 @@ double print_quality(const char* who, const TriMesh& input, const TriMesh& outpu
                   ? "preserved"
                   : "CHANGED",
               t.euler, t.boundary_loops, t.components, find_self_intersections(output, o.threads).size(), crossings_in);
+  const TriangleQuality tq = triangle_quality(output);
+  std::printf("%-5s: triangles: angles %.1f to %.1f degrees, %.3f %% with one under 30, %.3f %% obtuse; radius "
+              "ratio min %.3f, mean %.4f\n",
+              who, tq.min_angle, tq.max_angle, 100 * tq.below_30, 100 * tq.above_90, tq.min_radius_ratio,
+              tq.mean_radius_ratio);
   return 100 * h;
 }
 

@@ -169,6 +169,11 @@ void print_final(const TriMesh& mesh, const Job& job, const Result& result, cons
   }
   std::printf("  edge length:          mean %.6g, deviation %.4g, min %.6g, max %.6g\n", q.mean, q.deviation,
               s.min_edge, s.max_edge);
+  if (const auto& t = result.triangles; t && t->faces > 0)
+    std::printf("  triangles:            angles %.1f to %.1f degrees, %.3f %% with one under 30, %.3f %% obtuse; "
+                "radius ratio min %.3f, mean %.4f\n",
+                t->min_angle, t->max_angle, 100.0 * t->below_30, 100.0 * t->above_90, t->min_radius_ratio,
+                t->mean_radius_ratio);
   if (dual) {
     std::fflush(stdout);
     print_dual_stats(std::cout, *dual);

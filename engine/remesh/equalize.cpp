@@ -786,6 +786,7 @@ Result equalize(TriMesh& mesh, const Params& requested, const OnIteration& on_it
   // one leaves them unknown.
   if (!result.crossing_pairs && result.outcome != Outcome::Cancelled)
     result.crossing_pairs = find_self_intersections(mesh, threads).size();
+  if (result.outcome != Outcome::Cancelled) result.triangles = triangle_quality(mesh);
   result.seconds = seconds_since(start);
   return result;
 }

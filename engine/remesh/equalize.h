@@ -22,6 +22,7 @@
 #include "core/mesh.h"
 #include "remesh/params.h"
 #include "remesh/thin_parts.h"
+#include "remesh/triangle_quality.h"
 
 namespace remesh {
 
@@ -112,6 +113,8 @@ struct Result {
   /// sharing an edge never count, touching ones neither), after the untangling; left where the
   /// input crosses itself or parts are thinner than the edges. Unknown for a cancelled run.
   std::optional<std::size_t> crossing_pairs;
+  /// The returned mesh's triangle shapes (triangle_quality.h). Unknown for a cancelled run.
+  std::optional<TriangleQuality> triangles;
 };
 
 /// Estimated face count of the output: area / (sqrt(3)/4 * m^2), m = (e_min + e_max) / 2, e_max at

@@ -300,6 +300,7 @@ TEST_CASE("a short remesh run writes the mesh, the dual and one stats row per it
   INFO(r.err);
   REQUIRE(r.exit_code == 0);
   CHECK(r.out.find("completed") != std::string::npos);
+  CHECK(r.out.find("\n  triangles:            angles ") != std::string::npos);
   const auto j = info_json(out);
   CHECK(j.at("euler") == 2);
   CHECK(j.at("boundary_loops") == 0);

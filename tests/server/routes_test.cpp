@@ -92,6 +92,13 @@ TEST_CASE("remeshd: submit raw and multipart, follow, download, list, delete", "
   CHECK(done["thin_parts"]["in_thin_parts"] == 0);
   CHECK(done["thin_parts"]["limit"].get<double>() == Approx(0.4 / std::sqrt(3.0)));
   CHECK(done["crossing_pairs"] == 0);  // a ball's result does not cross itself
+  // The result's triangles: as many as a closed ball of its vertices and edges has (F = E - V + 2).
+  const json& tri = done["triangles"];
+  CHECK(tri["faces"] == done["latest"]["edges"].get<int>() - done["latest"]["vertices"].get<int>() + 2);
+  CHECK(tri["min_angle"].get<double>() <= 60);
+  CHECK(tri["max_angle"].get<double>() >= 60);
+  CHECK(tri["min_radius_ratio"].get<double>() <= tri["mean_radius_ratio"].get<double>());
+  CHECK(tri["mean_radius_ratio"].get<double>() <= 1);
   // The dual of the result: one atom per triangle, one bond per edge, one ring per vertex of the
   // ball (closed: sum of (6 - sides) = 12), its bonds judged against [0.2, 0.35] / sqrt(3).
   const json& dual = done["dual"];

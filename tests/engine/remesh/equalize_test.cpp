@@ -80,6 +80,26 @@ IterationStats remesh_and_check(TriMesh& mesh, const Params& p) {
   CHECK(t.filter > 0);
   CHECK(t.projection > 0);
   CHECK(t.setup > 0);
+  // The result's triangle shapes are the returned mesh's; where a face's three edges are inside
+  // the interval, no angle is below 2 asin(e_min / (2 e_max)) (the shortest edge facing it, the
+  // two longest beside it).
+  REQUIRE(result.triangles);
+  const TriangleQuality again = triangle_quality(mesh);
+  CHECK(result.triangles->faces == mesh.n_faces());
+  CHECK(result.triangles->min_angle == again.min_angle);
+  CHECK(result.triangles->mean_radius_ratio == again.mean_radius_ratio);
+  const double floor = 2 * std::asin(p.e_min / (2 * p.e_max));
+  for (auto f : mesh.faces()) {
+    Vec3 c[3];
+    int k = 0;
+    for (auto v : mesh.fv_range(f)) c[k++] = mesh.point(v);
+    bool inside = true;
+    for (int i = 0; i < 3; ++i) {
+      const double l = (c[i] - c[(i + 1) % 3]).norm();
+      inside = inside && l >= p.e_min && l <= p.e_max;
+    }
+    if (inside) CHECK(geom::min_angle(c[0], c[1], c[2]) >= floor - 1e-9);
+  }
   return last;
 }
 

@@ -227,6 +227,10 @@ export class JobView {
         `${share(by.thinner)} % in thinner parts`;
     }
     if (job.crossing_pairs > 0) text += ` · ${job.crossing_pairs} pairs of faces crossing each other`;
+    const tri = job.triangles;
+    if (tri && tri.faces > 0)
+      text += ` · angles ${tri.min_angle.toFixed(1)}° to ${tri.max_angle.toFixed(1)}°, ` +
+        `${(100 * tri.below_30).toFixed(2)} % of triangles with one under 30°`;
     const secs = this.rows.reduce((s, r) => s + (r.seconds || 0), 0);
     if (secs) text += ` · ${secs.toFixed(1)} s`;
     $('progress-text').textContent = text;
