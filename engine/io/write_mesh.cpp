@@ -55,7 +55,8 @@ std::string write_mesh(const PolyMesh& mesh, Format format) { return write_mesh(
 
 void write_mesh_file(const PolygonSoup& soup, const std::string& path) {
   const std::optional<Format> format = parse_format(path);
-  if (!format) throw MeshError("cannot tell the output format from '" + path + "' (use .obj .off .ply .stl .glb .xyz .lammps)");
+  if (!format)
+    throw MeshError("cannot tell the output format from '" + path + "' (use .obj .off .ply .stl .glb .xyz .lammps)");
   const std::string bytes = write_mesh(soup, *format);
   std::ofstream out(path, std::ios::binary | std::ios::trunc);
   if (!out) throw std::runtime_error("cannot open '" + path + "' for writing");

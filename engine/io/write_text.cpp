@@ -1,6 +1,6 @@
 /// \file write_text.cpp
-/// Text writers: OBJ, OFF (ASCII), XYZ and LAMMPS data. Coordinates use the shortest decimal form that reads
-/// back as the same double, so positions round-trip exactly.
+/// Text writers: OBJ, OFF (ASCII), XYZ and LAMMPS data. Coordinates use the shortest decimal form
+/// that reads back as the same double, so positions round-trip exactly.
 
 #include <algorithm>
 #include <charconv>
