@@ -19,7 +19,8 @@ void parse_vertex(std::string_view rest, std::size_t line, RawSoup& soup) {
   double c[3];
   std::string_view tok;
   for (double& v : c) {
-    if (!next_token(rest, tok)) fail_at(line, "vertex " + std::to_string(soup.points.size()) + " has fewer than 3 coordinates");
+    // No index: OBJ counts vertices from 1, the other messages from 0; the line says which.
+    if (!next_token(rest, tok)) fail_at(line, "a vertex with fewer than 3 coordinates");
     if (!parse_double(tok, v)) fail_at(line, "bad vertex coordinate " + quote(tok));
   }
   soup.points.emplace_back(c[0], c[1], c[2]);
