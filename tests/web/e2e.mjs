@@ -13,7 +13,7 @@ import net from 'node:net';
 import os from 'node:os';
 import path from 'node:path';
 import { fileURLToPath } from 'node:url';
-import { drawn_fraction, changed_fraction } from './png.mjs';
+import { decode_png, drawn_fraction, changed_fraction } from './png.mjs';
 import { icosphere_obj, parse_obj } from './meshes.mjs';
 
 const here = path.dirname(fileURLToPath(import.meta.url));
@@ -69,17 +69,40 @@ async function main() {
   check(Math.abs(filled.emin - 0.8 * mean) < 0.01 * mean && Math.abs(filled.emax - 1.2 * mean) < 0.01 * mean,
     `helper fills e_min/e_max = mean ±20 % (mean ${mean}, got ${filled.emin}..${filled.emax})`);
 
+  // --- the helper names the wrong field instead of using a default (± % = 0 used to mean 20 %) ---
+  await page.fill('#tolerance', '0');
+  await page.click('#apply-target');
+  const helper_error = await page.textContent('#helper-error');
+  const kept = +(await page.inputValue('#emin'));
+  check(/^± % must be/.test(helper_error) && await page.getAttribute('#tolerance', 'aria-invalid') === 'true' &&
+    await page.getAttribute('#target', 'aria-invalid') === null && kept === filled.emin,
+    `helper refuses ± % = 0 beside that field and leaves e_min alone ("${helper_error}")`);
+  await page.fill('#tolerance', '20');
+  check(await page.textContent('#helper-error') === '', 'editing ± % clears its message');
+
+  // --- a local check in the page's terms (labels, not API names) ---
+  await page.fill('#emax', String(filled.emin / 2));
+  await page.click('#submit');
+  const order_error = await page.textContent('.err[data-for="emax"]');
+  check(order_error === 'e_max must be greater than e_min', `local e_max < e_min message uses the labels ("${order_error}")`);
+  await page.fill('#emax', String(filled.emax));
+  check(await page.textContent('.err[data-for="emax"]') === '', 'editing e_max clears its message');
+
   // --- a 422 field error from the server, shown next to its field ---
   await page.fill('#iterations', '100000000');
   await page.click('#submit');
   const iter_error = await page.waitForSelector('.err[data-for="iterations"]:not(:empty)', { timeout: 10000 })
     .then((e) => e.textContent()).catch(() => '');
-  check(/iterations/.test(iter_error), `server's 422 for iterations shown beside the field ("${iter_error}")`);
+  check(/^Iterations /.test(iter_error), `server's 422 for iterations shown beside the field, by its label ("${iter_error}")`);
 
   // --- a long job started over the API (as with curl) holds the only worker, so the page's job
   // waits in the queue with its event stream open and every row of it must arrive live ---
   const blocker = await api_post_job(base, icosphere_obj(4), { emin: 0.01, emax: 0.02, iterations: 1000, run_all_iterations: true });
   check(await wait_state(base, blocker, ['running']), `API job ${blocker} running`);
+
+  // The recent-jobs list polls no more from here on: what it shows below came from the page's own
+  // refreshes (on submit, on the job's state changes).
+  await page.evaluate(() => { window.__remeshd.jobs.poll = { active: 2e9, idle: 2e9 }; return window.__remeshd.jobs.refresh(); });
 
   // --- the page's job: refine to 0.6 x mean, 4 iterations, all of them ---
   await page.fill('#target', String(+(0.6 * mean).toPrecision(4)));
@@ -89,6 +112,10 @@ async function main() {
   await page.click('#submit');
   await page.waitForFunction(() => /job=/.test(location.hash), null, { timeout: 10000 });
   const job_id = await page.evaluate(() => decodeURIComponent(/job=([^&]+)/.exec(location.hash)[1]));
+  check(await page.waitForSelector(`#jobs li[data-id="${job_id}"]`, { timeout: 10000 }).then(() => true, () => false),
+    'the submitted job is in the recent-jobs list without waiting for a poll');
+  check(await page.$eval('#job-id', (c) => c.textContent === c.innerText && getComputedStyle(c).textTransform === 'none'),
+    'the job id is shown as it is (ids are case-sensitive)');
   check(await page.waitForSelector('#summary dd', { timeout: 10000 }).then(() => true, () => false), 'input summary shown');
   const streaming = await page.waitForFunction(() => window.__remeshd.view.source?.readyState === 1, null, { timeout: 10000 })
     .then(() => true, () => false);
@@ -103,6 +130,8 @@ async function main() {
   await page.waitForSelector('#job-state.succeeded, #job-state.failed, #job-state.cancelled', { timeout: 30000 });
   const final_state = await page.textContent('#job-state');
   check(final_state === 'succeeded', `job ${job_id} succeeded (state ${final_state})`);
+  check(await page.waitForSelector(`#jobs li[data-id="${job_id}"] .state.succeeded`, { timeout: 10000 }).then(() => true, () => false),
+    'the recent-jobs list shows the job succeeded once it ended');
   const api_rows = await (await fetch(`${base}/api/v1/jobs/${job_id}/stats?format=json`)).json();
   const rows = Array.isArray(api_rows) ? api_rows : api_rows.rows || [];
   const table_rows = await page.$$eval('#rows tbody tr', (trs) => trs.length);
@@ -136,6 +165,12 @@ async function main() {
   check(remeshed_drawn > 0.02, `3D canvas draws the remeshed mesh (${(100 * remeshed_drawn).toFixed(1)} % of pixels)`);
   const hist_png = await page.locator('#histogram').screenshot();
   check(drawn_fraction(hist_png) > 0.005, 'edge-length histogram draws');
+  const last = rows[rows.length - 1] || {};
+  await check_histogram(page, 'remeshed', last);
+  const out_series = await page.evaluate(() => Object.fromEntries(window.__remeshd.view.charts
+    .find((c) => c.canvas.id === 'chart-out').series.map((s) => [s.label, s.color])));
+  check(out_series.small === '--short' && out_series.big === '--long',
+    `"Edges outside" draws small in the short colour and big in the long colour (${JSON.stringify(out_series)})`);
 
   // --- the dual, drawn with its polygon edges ---
   await page.click('label[for="show-dual"]');
@@ -144,6 +179,15 @@ async function main() {
   const dual_png = await page.locator('#view3d').screenshot({ path: path.join(artifacts, '3-dual-3d.png') });
   check(drawn_fraction(dual_png) > 0.02 && changed_fraction(remeshed_png, dual_png) > 0.005,
     `3D canvas draws the dual, different from the remeshed (${(100 * changed_fraction(remeshed_png, dual_png)).toFixed(1)} % changed)`);
+  const dual_view = await page.evaluate(() => ({ counts: window.__remeshd.state.viewer.current.counts,
+    status: document.getElementById('view-status').textContent,
+    legend: document.getElementById('legend').classList.contains('bond') }));
+  const near = (a, b) => Math.abs(a - b) <= Math.max(2, 0.01 * job_doc.dual.bonds);  // float32 positions in the GLB
+  check(dual_view.legend && /short · [\d,]+ long \(against e_min\/√3, e_max\/√3\)$/.test(dual_view.status) &&
+    near(dual_view.counts.short, job_doc.dual.short_bonds) && near(dual_view.counts.long, job_doc.dual.long_bonds),
+    `the dual's bonds are coloured against [e_min, e_max]/√3 like the job's counts (${JSON.stringify(dual_view.counts)} vs ` +
+    `${job_doc.dual.short_bonds} short, ${job_doc.dual.long_bonds} long; "${dual_view.status}")`);
+  await check_histogram(page, 'dual', null);
 
   // --- a download that parses ---
   const [download] = await Promise.all([page.waitForEvent('download', { timeout: 10000 }),
@@ -151,16 +195,80 @@ async function main() {
   const obj_path = path.join(artifacts, 'remeshed.obj');
   await download.saveAs(obj_path);
   const obj = parse_obj(fs.readFileSync(obj_path, 'utf8'));
-  const last = rows[rows.length - 1] || {};
   check(obj.error === '' && obj.vertices > 162 && obj.faces > 320,
     `remeshed.obj parses (${obj.vertices} v, ${obj.faces} f, refined from 162 v${obj.error ? `; ${obj.error}` : ''})`);
   check(obj.vertices - obj.edges + obj.faces === 2, `remeshed.obj is still a sphere (Euler ${obj.vertices - obj.edges + obj.faces})`);
   check(last.vertices === undefined || Math.abs(obj.vertices - last.vertices) <= 0.2 * last.vertices,
     `vertex count near the last row's (${obj.vertices} vs ${last.vertices})`);
 
-  // --- a reload reconnects to the job and shows every row again ---
+  // --- many rows at once (a fast job's stream chunk: one event each, in one task) are all kept and
+  // reach the table together in one later frame; the table follows the newest row while the user
+  // is at its bottom, and stays where the user scrolled it otherwise ---
+  const batch = await page.evaluate(async () => {
+    const view = window.__remeshd.view;
+    const body = document.querySelector('#rows tbody');
+    const wrap = body.closest('.tablewrap');
+    const frames = () => new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(r)));
+    const add = (n) => {
+      const last = view.rows[view.rows.length - 1];
+      for (let i = 1; i <= n; ++i) view.add_rows([{ ...last, iteration: last.iteration + i }]);
+    };
+    const gap = () => wrap.scrollHeight - wrap.scrollTop - wrap.clientHeight;
+    const before = body.rows.length;
+    const batches = view.batches;
+    add(500);
+    const in_task = body.rows.length;
+    await frames();
+    const out = { before, in_task, after: body.rows.length, held: view.rows.length, batches: view.batches - batches, gap: gap() };
+    wrap.scrollTop = 0;  // the user scrolls up to read
+    await frames();
+    add(20);
+    await frames();
+    out.scrolled_up = wrap.scrollTop;
+    wrap.scrollTop = wrap.scrollHeight;  // and back down
+    await frames();
+    add(20);
+    await frames();
+    out.gap_again = gap();
+    return out;
+  });
+  check(batch.in_task === batch.before && batch.after === batch.before + 500 && batch.held === batch.after && batch.batches === 1,
+    `500 rows delivered at once: none drawn in that task, all drawn in one batch (${JSON.stringify(batch)})`);
+  check(batch.gap < 24 && batch.scrolled_up === 0 && batch.gap_again < 24,
+    'the table follows the newest row at its bottom, and not after the user scrolled up');
+
+  // --- the json link of the recent jobs carries the token (opened in a new tab, without the
+  // page's Authorization header); this server needs none, so the token is only set for a moment ---
+  const links = await page.evaluate(async () => {
+    const { api, jobs } = window.__remeshd;
+    api.set_token('t0k&n');
+    const url = api.authorized_url('api/v1/jobs/ab?x=1');
+    await jobs.refresh();
+    const href = document.querySelector('#jobs li[data-id] a[target=_blank]').getAttribute('href');
+    api.set_token('');
+    await jobs.refresh();
+    return { url, href, plain: document.querySelector('#jobs li[data-id] a[target=_blank]').getAttribute('href') };
+  });
+  check(links.url === 'api/v1/jobs/ab?x=1&access_token=t0k%26n' && /\?access_token=t0k%26n$/.test(links.href) &&
+    !/access_token/.test(links.plain), `the jobs list's json link carries the token when one is set (${JSON.stringify(links)})`);
+
+  // --- a reload reconnects to the job and shows every row again; the input's GLB is held back
+  // until the remeshed one is in, so the input finishes loading last: the view must still show
+  // the mesh of the selected radio (Remeshed), not the last one loaded ---
+  const hold_input = async (route) => {
+    await page.waitForFunction(() => window.__remeshd?.state.viewer?.has('remeshed'), null, { timeout: 20000 }).catch(() => {});
+    await route.continue();
+  };
+  await page.route(/\/result\?mesh=input&format=glb/, hold_input);
   await page.reload({ waitUntil: 'load' });
   await page.waitForFunction(() => window.__remeshd, null, { timeout: 60000 });
+  await page.waitForFunction(() => { const s = window.__remeshd.state; return s.viewer.has('input') && s.viewer.has('remeshed') && !s.loading.size; },
+    null, { timeout: 30000 }).catch(() => {});
+  const race = await page.evaluate(() => ({ radio: document.querySelector('input[name=show]:checked').value,
+    status: document.getElementById('view-status').textContent, both: window.__remeshd.state.viewer.has('input') }));
+  check(race.both && race.radio === 'remeshed' && race.status.startsWith('remeshed ·'),
+    `the input loaded after the remeshed: the view still shows the selected radio's mesh (${race.radio}: "${race.status}")`);
+  await page.unroute(/\/result\?mesh=input&format=glb/, hold_input);
   await page.waitForFunction((n) => document.querySelectorAll('#rows tbody tr').length === n, rows.length, { timeout: 10000 })
     .catch(() => {});
   check(await page.$$eval('#rows tbody tr', (t) => t.length) === rows.length, 'after a reload the table holds every row again');
@@ -181,17 +289,87 @@ async function main() {
   check(lens_shown && lens_by && lens_text.includes(`${lens_share(lens_by.thicker)} % regular where the input is at least ` +
     `${lens_by.limit.toPrecision(3)} thick, ${lens_share(lens_by.thinner)} % in thinner parts`),
     `the lens's regular vertices by thickness shown as its job document has them (${JSON.stringify(lens_by)})`);
+  await page.waitForFunction(() => /^remeshed/.test(document.getElementById('view-status').textContent), null, { timeout: 15000 }).catch(() => {});
+  const lens_rows = await (await fetch(`${base}/api/v1/jobs/${lens_id}/stats?format=json`)).json();
+  await check_histogram(page, 'remeshed', (Array.isArray(lens_rows) ? lens_rows : lens_rows.rows || []).at(-1));
 
-  // --- garbage: the server's reader message appears ---
-  await page.setInputFiles('#file', garbage_path);
-  await page.fill('#emin', '0.1');
-  await page.fill('#emax', '0.2');
+  // --- a .txt name: no verdict before the server has tried ---
+  const txt_path = path.join(tmp, 'sphere.txt');
+  fs.writeFileSync(txt_path, icosphere_obj(2));
+  await page.setInputFiles('#file', txt_path);
+  const txt_status = await page.textContent('#view-status');
+  check(/server will try to detect the format/.test(txt_status), `an unknown extension defers to the server ("${txt_status}")`);
+
+  // --- an output-size estimate over the limit: beside e_min/e_max, in numbers one can read, focus
+  // there; editing the interval clears it ---
+  await page.setInputFiles('#file', mesh_path);
+  // The local preview fills e_min/e_max from the mean: wait for it, or it would overwrite them.
+  await page.waitForFunction(() => +document.getElementById('input-mean').dataset.value > 0, null, { timeout: 10000 });
+  await page.fill('#emin', '0.0001');
+  await page.fill('#emax', '0.0002');
   await page.click('#submit');
-  const bad = await page.waitForSelector('#repairs li.err', { timeout: 10000 }).then((e) => e.textContent()).catch(() => '');
-  check(/could not use this mesh/.test(bad) && bad.length > 30, `garbage file refused with the reader's message ("${bad}")`);
+  const size_error = await page.waitForSelector('.err[data-for="emin"]:not(:empty)', { timeout: 10000 })
+    .then((e) => e.textContent()).catch(() => '');
+  const size_focus = await page.evaluate(() => document.activeElement?.id);
+  check(/^e_min and e_max are so small that the result would have about [\d.]+ (million|billion|trillion) faces, more than this server's limit of [\d.,]+( million)?\. Use a larger e_min and e_max\.$/.test(size_error) &&
+    size_focus === 'emin' && await page.getAttribute('#emax', 'aria-invalid') === 'true' && await page.textContent('#file-error') === '',
+    `the output-size limit is shown beside e_min/e_max with focus there ("${size_error}", focus ${size_focus})`);
+  await page.fill('#emin', '0.1');
+  check(await page.textContent('.err[data-for="emin"]') === '' && await page.getAttribute('#emax', 'aria-invalid') === null,
+    'editing e_min clears the size message of both fields');
+  await page.fill('#emax', '0.2');
+
+  // --- garbage: the server's reader message, beside the file and by the button (focused) ---
+  await page.setInputFiles('#file', garbage_path);
+  await page.click('#submit');
+  const bad = await page.waitForSelector('#file-error:not(:empty)', { timeout: 10000 }).then((e) => e.textContent()).catch(() => '');
+  const by_button = await page.textContent('#form-error');
+  const bad_focus = await page.evaluate(() => document.activeElement?.id);
+  check(/^The server could not read garbage\.obj: .{10,}\. Fix the file or choose another one\.$/.test(bad) && by_button === bad && bad_focus === 'form-error',
+    `garbage file refused with the reader's message beside the file and by the button, focus there ("${bad}")`);
   await shot('4-garbage');
 
+  // --- an empty file: said beside the file chooser; choosing a good file clears it ---
+  const empty_path = path.join(tmp, 'empty.obj');
+  fs.writeFileSync(empty_path, '');
+  await page.setInputFiles('#file', empty_path);
+  await page.click('#submit');
+  const empty = await page.waitForSelector('#file-error:not(:empty)', { timeout: 10000 }).then((e) => e.textContent()).catch(() => '');
+  check(/^The file empty\.obj is empty\. Choose another file\.$/.test(empty) && await page.textContent('#form-error') === empty,
+    `an empty file is named beside the file chooser and by the button ("${empty}")`);
+  await page.setInputFiles('#file', mesh_path);
+  check(await page.textContent('#file-error') === '' && await page.textContent('#form-error') === '',
+    'choosing another file clears the last file\'s message');
+
   check(console_errors.length === 0, `no errors in the browser console${console_errors.length ? `: ${console_errors.join(' | ')}` : ''}`);
+}
+
+/// Checks the histogram of the mesh shown (`name`): its short/long bars hold exactly the edges the
+/// view colours short/long, no pixel has the short (long) colour when no edge is short (long), and
+/// none when the last statistics row `row` has every edge inside.
+async function check_histogram(page, name, row) {
+  const h = await page.evaluate(() => {
+    const v = window.__remeshd.state.viewer;
+    const sum = (a) => a.reduce((s, x) => s + x, 0);
+    const css = (n) => getComputedStyle(document.documentElement).getPropertyValue(n).trim();
+    return { name: v.current.name, short: sum(v.histogram.short), long: sum(v.histogram.long), counts: v.current.counts,
+      colours: [css('--short'), css('--long')] };
+  });
+  const png = decode_png(await page.locator('#histogram').screenshot());
+  const [short_px, long_px] = h.colours.map((hex) => {
+    const c = [1, 3, 5].map((i) => parseInt(hex.slice(i, i + 2), 16));
+    let n = 0;
+    for (let p = 0; p < png.data.length; p += png.channels)
+      if (c.every((v, k) => Math.abs(png.data[p + k] - v) <= 12)) ++n;
+    return n;
+  });
+  check(h.name === name && h.short === h.counts.short && h.long === h.counts.long &&
+    (h.short > 0 || short_px === 0) && (h.long > 0 || long_px === 0),
+    `the ${name} histogram's short/long bars hold exactly the short/long edges (${h.short}/${h.long} vs ` +
+    `${h.counts.short}/${h.counts.long}; ${short_px}/${long_px} pixels in the short/long colours)`);
+  if (row && row.small === 0 && row.big === 0)
+    check(h.short === 0 && h.long === 0, `no short or long bars when the job's last row has every edge inside (${h.short}/${h.long})`);
+  else if (row) log(`(the last row has ${row.small} small, ${row.big} big: the every-edge-inside histogram check is skipped)`);
 }
 
 /// POSTs a job as multipart (what curl -F does); returns its id.

@@ -103,15 +103,18 @@ export function result_url(id, mesh, format) {
 }
 export function stats_csv_url(id) { return `${BASE}/jobs/${encodeURIComponent(id)}/stats?format=csv`; }
 
-/// An EventSource on the job's events; `after` = last iteration already held (0 = none). The token
-/// travels as `access_token` because EventSource cannot send headers.
-export function events(id, after) {
-  const q = new URLSearchParams();
-  if (after > 0) q.set('lastEventId', String(after));
+/// `path` with the token (if any) as `access_token`, for what cannot send a header: an EventSource,
+/// a link the browser opens by itself. The server accepts it on every route.
+export function authorized_url(path) {
   const t = token();
-  if (t) q.set('access_token', t);
-  const qs = q.toString();
-  return new EventSource(`${BASE}/jobs/${encodeURIComponent(id)}/events${qs ? `?${qs}` : ''}`);
+  if (!t) return path;
+  return `${path}${path.includes('?') ? '&' : '?'}${new URLSearchParams({ access_token: t })}`;
+}
+
+/// An EventSource on the job's events; `after` = last iteration already held (0 = none).
+export function events(id, after) {
+  const path = `${BASE}/jobs/${encodeURIComponent(id)}/events`;
+  return new EventSource(authorized_url(after > 0 ? `${path}?lastEventId=${after}` : path));
 }
 
 /// Fetches a URL with the token and saves it under `fallback_name` (or the server's filename).

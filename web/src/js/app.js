@@ -85,6 +85,7 @@ async function choose_file(file) {
   $('summary').replaceChildren();
   $('repairs').replaceChildren();
   $('submit-status').textContent = '';
+  clear_file_error();  // the last file's complaint is not about this one
   for (const name of ['input', 'remeshed', 'dual']) state.viewer?.forget(name);
   set_available(['input']);
   $('show-input').checked = true;
@@ -92,7 +93,9 @@ async function choose_file(file) {
   state.input_of = null;
   state.watched = null;
   if (!['obj', 'off', 'ply', 'stl', 'gltf', 'glb'].includes(format_of(file.name))) {
-    status(`".${format_of(file.name)}" is not a mesh format remeshd reads; the server will say more.`);
+    // The server also reads the content (a mesh named .txt works), so this is no verdict yet.
+    status(`".${format_of(file.name)}" is not an extension the preview knows, so there is no preview; ` +
+      'the server will try to detect the format when you press Remesh.');
     return;
   }
   if (file.size > 200 * 1024 * 1024) { status('Large file: the preview appears after the upload.'); return; }
@@ -151,6 +154,7 @@ function show_repairs(repairs) {
 async function submit(e) {
   e.preventDefault();
   params.clear_field_errors();
+  clear_file_error();
   const p = params.read_params();
   if (!state.file && view.job) {
     // Watching a job started elsewhere: run again on its (server-read) input, as GLB.
@@ -180,11 +184,26 @@ async function submit(e) {
     $('submit-status').textContent = '';
     state.file_job = job.id;
     location.hash = `job=${encodeURIComponent(job.id)}`;  // hashchange starts watching
+    jobs.refresh();  // the new job belongs in the list now, not at the next poll
   } catch (err) {
     $('submit-status').textContent = '';
-    if (err.status === 422 && err.fieldErrors.length) params.show_field_errors(err.fieldErrors);
-    else if (err.status === 422) input_error(`The server could not use this mesh: ${err.message}`);
-    else if (err.status === 413) input_error(`Too big for this server: ${err.message}`);
+    const name = state.file?.name || 'the file';
+    const size = /the result would have about (\d+) faces, more than the limit of (\d+)/.exec(err.message);
+    if (err.status === 422 && err.fieldErrors.length) {
+      // Complaints about the file go beside it (and by the button); the rest beside their fields.
+      const about_file = err.fieldErrors.filter((f) => FILE_FIELDS.includes(f.field));
+      const others = err.fieldErrors.filter((f) => !FILE_FIELDS.includes(f.field));
+      if (others.length) params.show_field_errors(others);
+      if (about_file.length)
+        file_error(about_file.map((f) => f.field === 'mesh' ? `The file ${name} ${f.message}.` : `The file ${name}: ${f.field} ${f.message}.`)
+          .join(' ') + ' Choose another file.', { focus: !others.length });
+    } else if (err.status === 422) file_error(`The server could not read ${name}: ${err.message}. Fix the file or choose another one.`);
+    else if (err.status === 413 && size) {
+      params.show_field_errors([{ field: 'emin', text: `e_min and e_max are so small that the result would have about ` +
+        `${readable(+size[1])} faces, more than this server's limit of ${readable(+size[2])}. Use a larger e_min and e_max.` }],
+      { also: ['emax'] });
+    } else if (err.status === 413)
+      file_error(`${name} is too large for this server: ${readable_numbers(err.message)}. Choose a smaller mesh.`);
     else if (err.status === 503) $('submit-status').textContent = `Server busy (queue full): ${err.message}. Try again shortly.`;
     else if (err.status !== 401) $('submit-status').textContent = `Upload failed: ${err.message}`;
   } finally {
@@ -192,11 +211,30 @@ async function submit(e) {
   }
 }
 
-function input_error(text) {
-  const ul = $('repairs');
-  ul.replaceChildren(Object.assign(document.createElement('li'), { className: 'err', textContent: text }));
-  ul.querySelector('li').setAttribute('role', 'alert');
+/// The request fields that are about the uploaded file rather than a parameter.
+const FILE_FIELDS = ['mesh', 'format'];
+
+/// A complaint about the input file: beside the file chooser, where it belongs, and in the line by
+/// the Remesh button, where the user is looking after pressing it (focus moves there).
+function file_error(text, { focus = true } = {}) {
+  $('file-error').textContent = text;
+  $('form-error').textContent = text;
+  if (focus) $('form-error').focus();
 }
+
+function clear_file_error() {
+  $('file-error').textContent = '';
+  $('form-error').textContent = '';
+}
+
+/// 58602528135 -> "58.6 billion", 5000000 -> "5 million", 12345 -> "12,345".
+function readable(n) {
+  if (n >= 1e12) return `${+(n / 1e12).toPrecision(3)} trillion`;
+  if (n >= 1e9) return `${+(n / 1e9).toPrecision(3)} billion`;
+  if (n >= 1e6) return `${+(n / 1e6).toPrecision(3)} million`;
+  return n.toLocaleString('en-US');
+}
+function readable_numbers(text) { return String(text).replace(/\b\d{5,}\b/g, (d) => readable(+d)); }
 
 // ---- the watched job ----------------------------------------------------------------------------
 
@@ -218,15 +256,20 @@ const view = new JobView({
     }
     if (state.input_of !== job.id) {
       state.input_of = job.id;
-      load_mesh('input', job.id, true);
+      load_mesh('input', job.id);
+    }
+    // Queued, running, ended: the recent-jobs list shows the change now, not at its next poll.
+    const seen = `${job.id} ${job.state}`;
+    if (state.job_state !== seen) {
+      state.job_state = seen;
+      jobs.refresh();
     }
   },
   on_end(job) {
-    jobs.refresh();
     if (job.state !== 'succeeded') return;
     set_available(['input', 'remeshed', 'dual']);
     $('show-remeshed').checked = true;
-    load_mesh('remeshed', job.id, true);
+    load_mesh('remeshed', job.id);
   },
 });
 const jobs = new JobsList();
@@ -241,10 +284,9 @@ function reset_job_panel() {
   $('cancel').disabled = true;
   $('job-error').textContent = '';
   $('downloads').replaceChildren();
-  $('rows').tBodies[0].replaceChildren();
-  view.rows = [];
+  $('dual-summary').textContent = '';
+  view.clear_rows();
   view.job = null;
-  view.draw_rows();
 }
 
 function job_id_from_hash() {
@@ -269,21 +311,24 @@ function set_available(names) {
   for (const name of ['input', 'remeshed', 'dual']) $(`show-${name}`).disabled = !names.includes(name);
 }
 
-/// Fetches mesh=`name` as GLB for the job and shows it if `show` (or if it is the selected one).
-async function load_mesh(name, id, show) {
+/// Fetches mesh=`name` as GLB for the job and shows it if it is the selected one. Loads overlap (the
+/// input and the remeshed of a finished job): whichever finishes last must not replace the
+/// selected one, so the radio alone decides what is shown.
+async function load_mesh(name, id) {
   const viewer = state.viewer;
   if (!viewer) return;
   const key = `${id}/${name}`;
   if (state.loading.has(key)) return state.loading.get(key);
   const task = (async () => {
-    status(`loading ${name}…`);
+    if (selected() === name) status(`loading ${name}…`);  // else the status stays the shown mesh's
     try {
       const res = await api.request(api.result_url(id, name === 'input' ? 'input' : name, 'glb'));
       const mesh = await in_worker({ glb: await res.arrayBuffer() });
       if (view.job?.id !== id) return;
-      viewer.set_mesh(name, mesh, { classed: name !== 'dual',
+      // The dual's bonds are judged against [e_min, e_max] / √3 (the job's dual.bond_interval).
+      viewer.set_mesh(name, mesh, { scale: name === 'dual' ? 1 / Math.sqrt(3) : 1,
         label: name === 'dual' ? 'dual (polygon edges)' : name });
-      if (show || selected() === name) viewer.show(name);
+      if (selected() === name) viewer.show(name);
     } catch (e) {
       status(`Could not load the ${name} mesh: ${e.message}`);
     } finally {
@@ -299,7 +344,7 @@ function selected() { return document.querySelector('input[name=show]:checked')?
 async function init_viewer() {
   try {
     const { Viewer } = await import('./viewer.js');
-    state.viewer = new Viewer($('view3d'), $('histogram'), $('view-status'), $('hist-caption'));
+    state.viewer = new Viewer($('view3d'), $('histogram'), $('view-status'), $('hist-caption'), $('legend'));
   } catch (e) {
     status(`3D view unavailable: ${e.message}`);
     return;
@@ -307,7 +352,7 @@ async function init_viewer() {
   for (const radio of document.querySelectorAll('input[name=show]')) radio.addEventListener('change', () => {
     const name = selected();
     if (state.viewer.has(name)) state.viewer.show(name);
-    else if (view.job) load_mesh(name, view.job.id, true);
+    else if (view.job) load_mesh(name, view.job.id);
   });
   const options = () => state.viewer.set_options({ surface: $('opt-surface').checked,
     edges: $('opt-edges').checked, classes: $('opt-classes').checked });
@@ -345,4 +390,4 @@ state.viewer_ready = init_viewer();
 await state.viewer_ready;
 const initial = job_id_from_hash();
 if (initial) watch(initial);
-window.__remeshd = { state, view, jobs };  // for the browser test and for debugging in the console
+window.__remeshd = { state, view, jobs, api };  // for the browser test and for debugging in the console

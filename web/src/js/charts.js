@@ -168,42 +168,73 @@ export class IterationChart {
   }
 }
 
-/// Draws a histogram: counts (Uint32Array) over [lo, hi]; bars coloured by class with respect to
-/// [emin, emax] when `classes`, and the interval marked by vertical lines.
-export function draw_histogram(canvas, counts, lo, hi, emin, emax, classes) {
+/// Draws a histogram of edge lengths over [lo, hi]: `hist` = {short, inside, long} counts per bin
+/// (edges.js class_histogram). With `classes` each bar is split by the classes of its edges (so a
+/// result with no short or long edge shows no short or long colour), and [emin, emax] is marked
+/// by vertical lines labelled e_min/e_max + `suffix` (e.g. '/√3' for the dual).
+export function draw_histogram(canvas, hist, lo, hi, emin, emax, classes, suffix = '') {
   const fit = fit_canvas(canvas);
   if (!fit) return;
   const { ctx, w, h } = fit;
   const pad = { l: 8, r: 8, t: 4, b: 14 };
   const pw = w - pad.l - pad.r;
   const ph = h - pad.t - pad.b;
-  const peak = Math.max(1, ...counts);
+  const n = hist.inside.length;
+  const total = (b) => hist.short[b] + hist.inside[b] + hist.long[b];
+  let peak = 1;
+  for (let b = 0; b < n; ++b) peak = Math.max(peak, total(b));
   const x = (v) => pad.l + ((v - lo) / (hi - lo || 1)) * pw;
-  const bw = pw / counts.length;
-  const interval = classes && emax > emin && emin > 0;
-  for (let b = 0; b < counts.length; ++b) {
-    const centre = lo + ((b + 0.5) / counts.length) * (hi - lo);
-    ctx.fillStyle = css(!interval ? '--inside' : centre < emin ? '--short' : centre > emax ? '--long' : '--inside');
-    const bh = Math.sqrt(counts[b] / peak) * ph; // sqrt scale: the tails stay visible
-    ctx.fillRect(pad.l + b * bw, pad.t + ph - bh, Math.max(1, bw - 1), bh);
+  const bw = pw / n;
+  const colour = { short: css('--short'), inside: css('--inside'), long: css('--long') };
+  for (let b = 0; b < n; ++b) {
+    const count = total(b);
+    if (!count) continue;
+    const bh = Math.sqrt(count / peak) * ph;  // sqrt scale: the tails stay visible
+    let y = pad.t + ph;
+    // Stacked from the base: short, inside, long, each its share of the bar.
+    for (const cls of ['short', 'inside', 'long']) {
+      const part = hist[cls][b];
+      if (!part) continue;
+      const ch = bh * part / count;
+      ctx.fillStyle = classes ? colour[cls] : colour.inside;
+      ctx.fillRect(pad.l + b * bw, y - ch, Math.max(1, bw - 1), ch);
+      y -= ch;
+    }
   }
   ctx.font = '10px system-ui, sans-serif';
-  ctx.fillStyle = css('--muted');
   ctx.textBaseline = 'top';
+  const ty = h - pad.b + 2;
+  // e_min's label ends at its line and e_max's starts at its line, moved only to stay on the
+  // canvas and apart; the axis ends are labelled only where they leave room.
+  const labels = [];
+  if (emax > emin && emin > 0) {
+    for (const [v, name, before] of [[emin, 'e_min', true], [emax, 'e_max', false]]) {
+      if (v < lo || v > hi) continue;
+      const line = Math.round(x(v)) + 0.5;
+      const text = `${name}${suffix} ${fmt(v)}`;
+      const tw = ctx.measureText(text).width;
+      const start = Math.min(Math.max(before ? line - 3 - tw : line + 3, 0), w - tw);
+      labels.push({ line, text, start, end: start + tw });
+    }
+    if (labels.length === 2 && labels[1].start < labels[0].end + 6) {
+      labels[1].start = labels[0].end + 6;
+      labels[1].end = labels[1].start + ctx.measureText(labels[1].text).width;
+    }
+  }
+  const free = (a, b) => labels.every((l) => b + 6 < l.start || a > l.end + 6);
+  ctx.fillStyle = css('--muted');
   ctx.textAlign = 'left';
-  ctx.fillText(fmt(lo), pad.l, h - pad.b + 2);
-  ctx.textAlign = 'right';
-  ctx.fillText(fmt(hi), w - pad.r, h - pad.b + 2);
-  if (!(emax > emin && emin > 0)) return;
-  for (const [v, label] of [[emin, 'e_min'], [emax, 'e_max']]) {
-    if (v < lo || v > hi) continue;
-    const xx = Math.round(x(v)) + 0.5;
+  const lo_text = fmt(lo);
+  const hi_text = fmt(hi);
+  const hi_start = w - pad.r - ctx.measureText(hi_text).width;
+  if (free(pad.l, pad.l + ctx.measureText(lo_text).width)) ctx.fillText(lo_text, pad.l, ty);
+  if (free(hi_start, w - pad.r)) ctx.fillText(hi_text, hi_start, ty);
+  for (const l of labels) {
     ctx.strokeStyle = css('--text');
     ctx.setLineDash([3, 2]);
-    ctx.beginPath(); ctx.moveTo(xx, pad.t); ctx.lineTo(xx, pad.t + ph); ctx.stroke();
+    ctx.beginPath(); ctx.moveTo(l.line, pad.t); ctx.lineTo(l.line, pad.t + ph); ctx.stroke();
     ctx.setLineDash([]);
     ctx.fillStyle = css('--text');
-    ctx.textAlign = 'center';
-    ctx.fillText(`${label} ${fmt(v)}`, xx, h - pad.b + 2);
+    ctx.fillText(l.text, l.start, ty);
   }
 }

@@ -97,14 +97,19 @@ export function length_stats(lengths) {
     deviation: Math.sqrt(Math.max(0, sum2 / n - mean * mean)) };
 }
 
-/// Histogram of lengths over [lo, hi] in `bins` bins (values outside land in the end bins).
-export function histogram(lengths, lo, hi, bins) {
-  const counts = new Uint32Array(bins);
+/// Histogram of lengths over [lo, hi] in `bins` bins (values outside land in the end bins), one
+/// count array per class of `classify` ({short, inside, long}, Uint32Array each), so a bar's
+/// colours say exactly how many of its edges are short or long, whatever the bin edges.
+/// Without a valid interval every edge counts as inside.
+export function class_histogram(lengths, lo, hi, bins, emin, emax) {
+  const out = { short: new Uint32Array(bins), inside: new Uint32Array(bins), long: new Uint32Array(bins) };
+  const valid = Number.isFinite(emin) && Number.isFinite(emax) && emin > 0 && emax > emin;
   const scale = hi > lo ? bins / (hi - lo) : 0;
   for (let e = 0; e < lengths.length; ++e) {
-    let b = Math.floor((lengths[e] - lo) * scale);
+    const len = lengths[e];
+    let b = Math.floor((len - lo) * scale);
     if (b < 0) b = 0; else if (b >= bins) b = bins - 1;
-    ++counts[b];
+    ++(!valid ? out.inside : len < emin ? out.short : len > emax ? out.long : out.inside)[b];
   }
-  return counts;
+  return out;
 }

@@ -21,6 +21,9 @@ const TABLE = [
 const STEPS = ['stellar', 'flips', 'filter', 'projection', 'guards', 'cleanup', 'snap', 'untangle', 'setup', 'other',
   'total'];
 
+/// Within a few pixels of the bottom of the scrolled element.
+function at_bottom(el) { return el.scrollHeight - el.scrollTop - el.clientHeight < 24; }
+
 function int(v) { return Number.isFinite(v) ? v.toLocaleString('en-US') : '–'; }
 function num(v) { return Number.isFinite(v) ? String(+v.toPrecision(5)) : '–'; }
 function fixed(v, d) { return Number.isFinite(v) ? v.toFixed(d) : '–'; }
@@ -59,15 +62,24 @@ export class JobView {
       { marks: () => [{ value: params().emin, label: 'e_min', color: '--short' },
         { value: params().emax, label: 'e_max', color: '--long' }] }),
       new IterationChart($('chart-out'), [
-        { key: (r) => r.small + r.big, label: 'outside', color: '--err' },
-        { key: (r) => r.small, label: 'small', color: '--ok' },
-        { key: (r) => r.big, label: 'big', color: '--short' }]),
+        // The 3D view's and histogram's colours: short (< e_min) and long (> e_max); the total neutral.
+        { key: (r) => r.small + r.big, label: 'outside', color: '--text' },
+        { key: (r) => r.small, label: 'small', color: '--short' },
+        { key: (r) => r.big, label: 'big', color: '--long' }]),
       new IterationChart($('chart-vertices'), [{ key: (r) => r.vertices, label: 'vertices', color: '--accent' }],
         { min_zero: false }),
       new IterationChart($('chart-regular'), [{ key: (r) => r.regular_percent, label: 'regular %', color: '--ok' }],
         { percent: true }),
       new IterationChart($('chart-seconds'), [{ key: (r) => r.seconds, label: 'seconds', color: '--accent', bars: true }]),
     ];
+    this.queued = [];       // rows held but not yet in the table (drawn once per animation frame)
+    this.frame = 0;         // the pending requestAnimationFrame, 0 = none
+    this.follow = true;     // the table scrolls to the newest row while the user is at its bottom
+    this.batches = 0;       // table renders so far (the browser test checks rows arrive in batches)
+    const wrap = $('rows').closest('.tablewrap');
+    // Growing content fires no scroll event, so `follow` changes only when the user (or our own
+    // scroll to the bottom) moves the table; a reload starts at the top with follow still on.
+    wrap.addEventListener('scroll', () => { this.follow = at_bottom(wrap); });
     $('cancel').addEventListener('click', () => this.cancel());
   }
 
@@ -77,9 +89,7 @@ export class JobView {
     const generation = ++this.generation;
     this.ended_id = null;
     this.streamed = 0;  // rows that arrived over the event stream (the rest came from /stats)
-    this.rows = [];
-    $('rows').tBodies[0].replaceChildren();
-    this.draw_rows();
+    this.clear_rows();
     $('job-id').textContent = id;
     $('job-error').textContent = '';
     $('dual-summary').textContent = '';  // the last job's, until this one's document arrives
@@ -173,30 +183,59 @@ export class JobView {
     for (const c of this.charts) c.schedule();
   }
 
-  /// Appends rows newer than the last one held; returns how many were new.
+  /// Forgets every row (a new job, or none) and empties the table.
+  clear_rows() {
+    this.rows = [];
+    this.queued = [];
+    cancelAnimationFrame(this.frame);
+    this.frame = 0;
+    this.follow = true;
+    $('rows').tBodies[0].replaceChildren();
+    this.draw_rows();
+  }
+
+  /// Takes rows newer than the last one held; returns how many were new. The table, the charts and
+  /// the head follow once per animation frame: a fast job's stream delivers hundreds of rows in one
+  /// network chunk, and a table row, a layout read and the head per row froze the page for seconds.
   add_rows(rows) {
     let last = this.rows.length ? this.rows[this.rows.length - 1].iteration : -Infinity;
-    const body = $('rows').tBodies[0];
-    const fresh = [];
+    let fresh = 0;
     for (const row of rows) {
       if (!(row.iteration > last)) continue;  // a row seen already (reconnect overlap)
       last = row.iteration;
       this.rows.push(row);
-      fresh.push(row);
+      this.queued.push(row);
+      ++fresh;
+    }
+    if (fresh && !this.frame) this.frame = requestAnimationFrame(() => this.render_rows());
+    return fresh;
+  }
+
+  /// Appends the queued rows to the table in one go, then the charts and the head.
+  render_rows() {
+    this.frame = 0;
+    const rows = this.queued;
+    this.queued = [];
+    if (!rows.length) return;
+    const body = $('rows').tBodies[0];
+    const batch = document.createDocumentFragment();
+    for (const row of rows) {
       const tr = document.createElement('tr');
       for (const [key, f] of TABLE) {
         const td = document.createElement('td');
         td.textContent = f(row[key]);
         tr.append(td);
       }
-      body.append(tr);
+      batch.append(tr);
     }
-    if (!fresh.length) return 0;
-    const wrap = body.closest('.tablewrap');
-    if (wrap.scrollHeight - wrap.scrollTop - wrap.clientHeight < 60) wrap.scrollTop = wrap.scrollHeight;
+    body.append(batch);
+    ++this.batches;
+    if (this.follow) {
+      const wrap = body.closest('.tablewrap');
+      wrap.scrollTop = wrap.scrollHeight;  // the one layout read of the batch
+    }
     this.draw_rows();
-    this.render_head();
-    return fresh.length;
+    if (this.job) this.render_head();
   }
 
   draw_rows() { for (const c of this.charts) c.set_rows(this.rows); }

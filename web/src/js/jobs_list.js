@@ -9,6 +9,10 @@ export class JobsList {
   constructor() {
     this.timer = null;
     this.current = '';
+    this.requests = 0;
+    /// Milliseconds between polls while some job is active, and otherwise (the page also refreshes
+    /// on submit and on every state change of the watched job).
+    this.poll = { active: 3000, idle: 15000 };
     $('jobs-refresh').addEventListener('click', () => this.refresh());
     document.addEventListener('visibilitychange', () => { if (!document.hidden) this.refresh(); });
   }
@@ -21,16 +25,19 @@ export class JobsList {
   /// Fetches the list now and again every few seconds while anything is active.
   async refresh() {
     clearTimeout(this.timer);
+    const request = ++this.requests;
     let active = false;
     try {
       const body = await api.list_jobs(20);
+      if (request !== this.requests) return;  // a later refresh is under way: its answer is newer
       const jobs = body.jobs || [];
       active = jobs.some((j) => ['queued', 'running', 'cancelling'].includes(j.state));
       this.render(jobs, body.total ?? jobs.length);
     } catch (e) {
+      if (request !== this.requests) return;
       $('jobs').replaceChildren(Object.assign(document.createElement('li'), { className: 'err', textContent: e.message }));
     }
-    if (!document.hidden) this.timer = setTimeout(() => this.refresh(), active ? 3000 : 15000);
+    if (!document.hidden) this.timer = setTimeout(() => this.refresh(), active ? this.poll.active : this.poll.idle);
   }
 
   render(jobs, total) {
@@ -51,7 +58,8 @@ export class JobsList {
       a.textContent = job.input?.filename || job.id;
       a.title = `Watch job ${job.id}`;
       const events = document.createElement('a');
-      events.href = `${api.BASE}/jobs/${encodeURIComponent(job.id)}`;
+      // Opened by the browser in a new tab, without the page's Authorization header.
+      events.href = api.authorized_url(`${api.BASE}/jobs/${encodeURIComponent(job.id)}`);
       events.textContent = 'json';
       events.title = 'The job document';
       events.target = '_blank';

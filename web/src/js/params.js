@@ -33,62 +33,120 @@ export function interval() {
   return { emin: $('emin').valueAsNumber, emax: $('emax').valueAsNumber };
 }
 
+/// The page's name of each API field, for messages (the API's emin reads "e_min" on the page).
+const LABELS = { emin: 'e_min', emax: 'e_max', iterations: 'Iterations', rings: 'Rings k',
+  relax_every: 'Relax every', flip_factor: 'Flip factor f', run_all_iterations: 'Run all iterations',
+  protect_tips: 'Protect tips', keep_creases: 'Keep creases', more_regular: 'More regular',
+  relax_dual: "Relax the dual's bonds", weld: 'Weld duplicate vertices', mesh: 'The file' };
+
+export function label(field) { return LABELS[field] || field; }
+
+/// A server message with the API's field names replaced by the page's labels.
+export function in_page_terms(text) {
+  return String(text).replace(/\b(emin|emax|relax_every|flip_factor|run_all_iterations|protect_tips|keep_creases|more_regular|relax_dual)\b/g,
+    (name) => LABELS[name]);
+}
+
 /// Local checks that save a round trip; the server's answer stays the authority.
 export function local_errors(p) {
   const errs = [];
-  if (p.emin === undefined) errs.push({ field: 'emin', message: 'is required' });
-  else if (!(p.emin > 0)) errs.push({ field: 'emin', message: 'must be a number > 0' });
-  if (p.emax === undefined) errs.push({ field: 'emax', message: 'is required' });
-  else if (!(p.emax > 0)) errs.push({ field: 'emax', message: 'must be a number > 0' });
+  if (p.emin === undefined) errs.push({ field: 'emin', message: 'is required: enter the shortest edge length wanted' });
+  else if (!(p.emin > 0)) errs.push({ field: 'emin', message: 'must be a number greater than 0' });
+  if (p.emax === undefined) errs.push({ field: 'emax', message: 'is required: enter the longest edge length wanted' });
+  else if (!(p.emax > 0)) errs.push({ field: 'emax', message: 'must be a number greater than 0' });
   else if (p.emin > 0 && !(p.emax > p.emin)) errs.push({ field: 'emax', message: 'must be greater than e_min' });
   return errs;
 }
 
-/// Shows [{field, message}] next to their fields; errors for unknown fields go to the form's line.
-export function show_field_errors(errors) {
+/// Shows [{field, message}] next to their fields; errors for unknown fields go to the form's line
+/// above the Remesh button. `also`: more fields to mark invalid with the first field's message
+/// (the output-size estimate is about e_min and e_max together). Focus moves to the first field.
+export function show_field_errors(errors, { also = [] } = {}) {
   clear_field_errors();
   const form = $('params');
   const general = [];
-  for (const { field, message } of errors) {
+  // `message` completes the field's label ("must be > 0"); `text` is a whole sentence of its own.
+  for (const { field, message, text: whole } of errors) {
     const slot = form.querySelector(`.err[data-for="${CSS.escape(field || '')}"]`);
-    const input = field && form.elements[field];
+    const text = whole || in_page_terms(message);
     if (slot && slot.dataset.for !== 'params') {
-      slot.textContent = slot.textContent ? `${slot.textContent}; ${message}` : `${field} ${message}`;
-      if (input) {
-        input.setAttribute('aria-invalid', 'true');
-        input.setAttribute('aria-describedby', slot.id || (slot.id = `err-${field}`));
+      const own = whole || `${label(field)} ${text}`;
+      slot.textContent = slot.textContent ? `${slot.textContent}; ${text}` : own;
+      for (const f of [field, ...(field === errors[0].field ? also : [])]) {
+        const el = form.elements[f];
+        if (!el) continue;
+        el.setAttribute('aria-invalid', 'true');
+        el.setAttribute('aria-describedby', slot.id || (slot.id = `err-${field}`));
       }
-    } else general.push(field ? `${field}: ${message}` : message);
+    } else general.push(field ? `${label(field)}: ${text}` : text);
   }
   form.querySelector('.err[data-for="params"]').textContent = general.join('; ');
   const first = form.querySelector('[aria-invalid=true]');
   if (first) first.focus();
 }
 
-export function clear_field_errors() {
+/// Clears the messages of the form's fields (all of them, or those of `fields`). The line above
+/// the Remesh button is cleared only when clearing all.
+export function clear_field_errors(fields) {
   const form = $('params');
-  for (const e of form.querySelectorAll('.err')) e.textContent = '';
-  for (const i of form.querySelectorAll('[aria-invalid]')) i.removeAttribute('aria-invalid');
+  for (const e of form.querySelectorAll('.err')) if (!fields || fields.includes(e.dataset.for)) e.textContent = '';
+  for (const i of form.querySelectorAll('[aria-invalid]')) {
+    if (fields && !fields.includes(i.name || i.id)) continue;
+    i.removeAttribute('aria-invalid');
+    i.removeAttribute('aria-describedby');
+  }
+}
+
+/// Editing a field clears its message (a fixed value must not keep its old complaint); e_min and
+/// e_max go together, since their messages (order, output size) are about both.
+function clear_on_edit() {
+  const form = $('params');
+  form.addEventListener('input', (e) => {
+    const name = e.target.name;
+    if (!name) return;
+    clear_field_errors(name === 'emin' || name === 'emax' ? ['emin', 'emax'] : [name]);
+  });
 }
 
 /// The helper: target mean ± tolerance % -> emin/emax. `on_change` runs after the form changed.
+/// A wrong target or tolerance is named beside the helper instead of being replaced by a default.
 export function init_helper(on_change) {
+  clear_on_edit();
+  const error = $('helper-error');
+  const complain = (field, text) => {
+    for (const id of ['target', 'tolerance']) {
+      if (id === field) { $(id).setAttribute('aria-invalid', 'true'); $(id).setAttribute('aria-describedby', 'helper-error'); }
+      else { $(id).removeAttribute('aria-invalid'); $(id).removeAttribute('aria-describedby'); }
+    }
+    error.textContent = text;
+  };
   const apply = () => {
     const target = $('target').valueAsNumber;
-    const tol = ($('tolerance').valueAsNumber || 20) / 100;
-    if (!(target > 0) || !(tol > 0 && tol < 1)) {
-      $('target').setAttribute('aria-invalid', 'true');
+    const percent = $('tolerance').valueAsNumber;
+    if (!(target > 0)) {
+      complain('target', $('target').value === '' && !$('target').validity.badInput
+        ? 'Target mean is empty: enter the edge length wanted (or press "use it" for the input\'s mean).'
+        : 'Target mean must be a number greater than 0.');
       return;
     }
-    $('target').removeAttribute('aria-invalid');
+    if (!(percent > 0 && percent < 100)) {
+      complain('tolerance', '± % must be a number between 0 and 100, for example 20 (e_min = target − 20 %, e_max = target + 20 %).');
+      return;
+    }
+    complain('', '');
+    const tol = percent / 100;
     $('emin').value = round(target * (1 - tol));
     $('emax').value = round(target * (1 + tol));
+    clear_field_errors(['emin', 'emax']);
     on_change();
   };
   $('apply-target').addEventListener('click', apply);
-  for (const id of ['target', 'tolerance']) $(id).addEventListener('keydown', (e) => {
-    if (e.key === 'Enter') { e.preventDefault(); apply(); }
-  });
+  for (const id of ['target', 'tolerance']) {
+    $(id).addEventListener('keydown', (e) => {
+      if (e.key === 'Enter') { e.preventDefault(); apply(); }
+    });
+    $(id).addEventListener('input', () => { if ($(id).hasAttribute('aria-invalid')) complain('', ''); });
+  }
   $('use-mean').addEventListener('click', () => {
     const mean = +$('input-mean').dataset.value;
     if (mean > 0) { $('target').value = round(mean); apply(); }

@@ -5,15 +5,17 @@
 
 import * as THREE from 'three';
 import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
-import { triangle_edges, edge_lengths, classify, length_stats, histogram } from './edges.js';
+import { triangle_edges, edge_lengths, classify, length_stats, class_histogram } from './edges.js';
 import { css, draw_histogram, fit_canvas, fmt } from './charts.js';
 
 const BINS = 64;
 
 export class Viewer {
-  /// canvas: the WebGL canvas; hist: the histogram canvas; status/caption: text elements.
-  constructor(canvas, hist, status, caption) {
+  /// canvas: the WebGL canvas; hist: the histogram canvas; status/caption: text elements; legend:
+  /// the colour legend (its class `bond` says the interval is divided by √3, for the dual).
+  constructor(canvas, hist, status, caption, legend = null) {
     this.canvas = canvas;
+    this.legend = legend;
     this.hist = hist;
     this.status = status;
     this.caption = caption;
@@ -63,7 +65,7 @@ export class Viewer {
   update_edge_colors() {
     const [s, i, l] = this.edge_materials;
     const inside = this.options.surface ? this.inside_on_surface : this.inside_alone;
-    const classes = this.options.classes && this.current?.classed;
+    const classes = this.options.classes && !!this.current;
     s.color.set(classes ? css('--short') : inside);
     i.color.copy(inside);
     l.color.set(classes ? css('--long') : inside);
@@ -100,9 +102,9 @@ export class Viewer {
 
   /// Prepares a mesh {positions, triangles, lines?, pairs?, lengths?} under a name ('input',
   /// 'remeshed', 'dual'); `pairs`/`lengths` are the edges when already computed (mesh_worker.js).
-  /// `classed`: colour its edges against [e_min, e_max] (not for the dual, whose edges are shorter
-  /// by design). Polygon edges come from `lines` when given, else from the triangles.
-  set_mesh(name, mesh, { classed = true, label = name } = {}) {
+  /// `scale`: its edges are judged against [e_min, e_max] × scale (the dual's bonds: 1/√3, as the
+  /// server counts them). Polygon edges come from `lines` when given, else from the triangles.
+  set_mesh(name, mesh, { scale = 1, label = name } = {}) {
     this.forget(name);
     const vertex_count = mesh.positions.length / 3;
     const position = new THREE.BufferAttribute(mesh.positions, 3);
@@ -120,7 +122,7 @@ export class Viewer {
     const edges = new THREE.LineSegments(edge_geometry, this.edge_materials);
     const group = new THREE.Group();
     group.add(surface, edges);
-    const slot = { name, label, geometry, edge_geometry, surface, edges, group, pairs, lengths, classed,
+    const slot = { name, label, geometry, edge_geometry, surface, edges, group, pairs, lengths, scale,
       stats: length_stats(lengths), vertices: used_vertices(pairs, vertex_count), faces: mesh.triangles.length / 3 };
     this.slots.set(name, slot);
     this.reclassify(slot);
@@ -135,6 +137,7 @@ export class Viewer {
     if (this.current) this.scene.remove(this.current.group);
     this.current = slot;
     this.scene.add(slot.group);
+    this.legend?.classList.toggle('bond', slot.scale !== 1);
     this.apply_options();
     if (first || !this.fitted_radius) this.fit();
     this.update_status();
@@ -162,8 +165,11 @@ export class Viewer {
     this.render();
   }
 
+  /// The interval a slot's edges are judged against.
+  interval_of(slot) { return { emin: this.interval.emin * slot.scale, emax: this.interval.emax * slot.scale }; }
+
   reclassify(slot) {
-    const { emin, emax } = slot.classed ? this.interval : { emin: NaN, emax: NaN };
+    const { emin, emax } = this.interval_of(slot);
     const index = slot.edge_geometry.index;
     slot.counts = classify(slot.pairs, slot.lengths, emin, emax, index.array);
     index.needsUpdate = true;
@@ -206,29 +212,48 @@ export class Viewer {
     if (!s) return;
     const c = s.counts;
     const parts = [`${s.label}`, `${s.vertices.toLocaleString()} v`];
-    if (s.classed) parts.push(`${s.faces.toLocaleString()} f`);  // the dual's triangles are a fan, not its faces
+    if (s.scale === 1) parts.push(`${s.faces.toLocaleString()} f`);  // the dual's triangles are a fan, not its faces
     parts.push(`${s.lengths.length.toLocaleString()} e`);
-    if (s.classed && c.short + c.long + c.inside && this.interval.emax > this.interval.emin)
-      parts.push(`${c.short.toLocaleString()} short · ${c.long.toLocaleString()} long`);
+    if (c.short + c.long + c.inside && this.interval.emax > this.interval.emin)
+      parts.push(`${c.short.toLocaleString()} short · ${c.long.toLocaleString()} long` + (s.scale === 1 ? '' : ' (against e_min/√3, e_max/√3)'));
     this.status.textContent = parts.join(' · ');
   }
 
   draw_histogram() {
     const s = this.current;
     if (!s) return;
-    const { emin, emax } = s.classed ? this.interval : { emin: NaN, emax: NaN };
+    const { emin, emax } = this.interval_of(s);
+    const interval = emax > emin && emin > 0;
     const st = s.stats;
-    // Up to mean + 4 deviations (a few huge edges must not squash the rest), but always past e_max.
+    // Up to mean + 4 deviations (a few huge edges must not squash the rest), but always past e_max;
+    // from just below the shortest edge (or e_min), so the bars use the width.
     let hi = Math.min(st.max, st.mean + 4 * st.deviation);
-    if (Number.isFinite(emax) && emax > 0) hi = Math.max(hi, emax * 1.1);
-    if (!(hi > 0)) hi = st.max || 1;
-    const lo = 0;
-    draw_histogram(this.hist, histogram(s.lengths, lo, hi, BINS), lo, hi, emin, emax,
-      this.options.classes && s.classed);
+    let lo = Math.max(0, Math.min(st.min, interval ? emin : st.min) - 0.05 * (hi - st.min));
+    if (interval) hi = Math.max(hi, emax + 0.1 * (emax - lo));
+    if (!(hi > lo)) { lo = 0; hi = st.max || 1; }
+    const bins = interval ? aligned_bins(lo, hi, emin, emax) : { lo, hi, count: BINS };
+    const hist = class_histogram(s.lengths, bins.lo, bins.hi, bins.count, interval ? emin : NaN, interval ? emax : NaN);
+    this.histogram = hist;  // read by the browser test
+    const scaled = s.scale === 1 ? '' : '/√3';
+    draw_histogram(this.hist, hist, bins.lo, bins.hi, emin, emax, this.options.classes, scaled);
     this.caption.textContent = `Edge lengths of the ${s.label} (${st.count.toLocaleString()} edges):` +
       ` mean ${fmt(st.mean)}, deviation ${fmt(st.deviation)}, min ${fmt(st.min)}, max ${fmt(st.max)}` +
-      (hi < st.max ? ` (axis clipped at ${fmt(hi)})` : '');
+      (bins.hi < st.max ? ` (axis clipped at ${fmt(bins.hi)})` : '') +
+      (scaled && interval ? `; coloured against e_min/√3 ${fmt(emin)} and e_max/√3 ${fmt(emax)}` : '');
   }
+}
+
+/// About BINS bins over [lo, hi] with e_min and e_max on bin edges, so a bar lies on one side of
+/// each (the counts per class stay exact either way: class_histogram splits by the edges' class).
+function aligned_bins(lo, hi, emin, emax) {
+  const inside = Math.max(1, Math.round(BINS * (emax - emin) / (hi - lo)));
+  const w = (emax - emin) / inside;
+  const below = Math.max(0, Math.min(Math.ceil((emin - lo) / w - 1e-9), Math.floor(emin / w + 1e-9)));
+  const above = Math.max(1, Math.ceil((hi - emax) / w - 1e-9));
+  // An interval tiny against the spread of lengths (an input far from it) would need thousands of
+  // bins: then the bins ignore it and only the split of the bars shows the classes.
+  if (below + inside + above > 2 * BINS) return { lo, hi, count: BINS };
+  return { lo: emin - below * w, hi: emax + above * w, count: below + inside + above };
 }
 
 /// Vertices that some edge uses (a GLB may carry positions for the fan triangulation only).
