@@ -94,6 +94,21 @@ async function main() {
   const iter_error = await page.waitForSelector('.err[data-for="iterations"]:not(:empty)', { timeout: 10000 })
     .then((e) => e.textContent()).catch(() => '');
   check(/^Iterations /.test(iter_error), `server's 422 for iterations shown beside the field, by its label ("${iter_error}")`);
+  await page.fill('#iterations', '100');
+
+  // --- the less-used options are folded, so Remesh is in the first screen; an error in one of
+  // them unfolds them and takes focus ---
+  check(!(await page.$eval('#more-options', (d) => d.open)), 'the less-used options are folded at first');
+  const submit_top = await page.$eval('#submit', (b) => b.getBoundingClientRect().bottom + window.scrollY);
+  check(submit_top < 800, `Remesh within the first 800 px of the page (${Math.round(submit_top)})`);
+  await page.click('#more-options > summary');
+  await page.fill('#flip_factor', '2');
+  await page.click('#more-options > summary');
+  await page.click('#submit');
+  await page.waitForSelector('.err[data-for="flip_factor"]:not(:empty)', { timeout: 10000 }).catch(() => null);
+  check(await page.$eval('#more-options', (d) => d.open) && await page.evaluate(() => document.activeElement?.id) === 'flip_factor',
+    'an error in a folded option unfolds the options and focuses its field');
+  await page.fill('#flip_factor', '0.5');
 
   // --- a long job started over the API (as with curl) holds the only worker, so the page's job
   // waits in the queue with its event stream open and every row of it must arrive live ---

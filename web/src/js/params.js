@@ -5,6 +5,8 @@ const $ = (id) => document.getElementById(id);
 
 const NUMBERS = ['emin', 'emax', 'iterations', 'rings', 'relax_every', 'flip_factor'];
 const BOOLEANS = ['run_all_iterations', 'protect_tips', 'keep_creases', 'more_regular', 'relax_dual', 'weld'];
+/// The fields inside "More options" (index.html).
+const FOLDED = ['rings', 'relax_every', 'flip_factor', ...BOOLEANS];
 
 /// The params object for POST /jobs. Empty fields are left out (the server applies its defaults,
 /// and reports a missing emin/emax itself); text the browser cannot parse as a number is sent
@@ -26,6 +28,9 @@ export function write_params(params) {
   if (!params) return;
   for (const name of NUMBERS) if (params[name] !== undefined) $(name).value = params[name];
   for (const name of BOOLEANS) if (params[name] !== undefined) $(name).checked = !!params[name];
+  // A job that used any of the folded options shows them.
+  if (FOLDED.some((name) => $(name).type === 'checkbox' ? $(name).checked : $(name).value !== $(name).defaultValue))
+    $('more-options').open = true;
 }
 
 /// The interval currently typed in the form (NaN when missing).
@@ -82,6 +87,8 @@ export function show_field_errors(errors, { also = [] } = {}) {
   }
   form.querySelector('.err[data-for="params"]').textContent = general.join('; ');
   const first = form.querySelector('[aria-invalid=true]');
+  // A field in the folded options is shown before it takes focus.
+  if (first) first.closest('details')?.setAttribute('open', '');
   if (first) first.focus();
 }
 
