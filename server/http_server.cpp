@@ -594,7 +594,8 @@ void HttpServer::Impl::post_job(const httplib::Request& req, httplib::Response& 
     send_problem(res, 422, "invalid request: see errors", errors);
     return;
   }
-  if (filename.empty()) filename = "mesh" + (format ? "." + std::string(remesh::format_name(*format)) : std::string());
+  const bool named = !filename.empty();
+  if (!named) filename = "mesh" + (format ? "." + std::string(remesh::format_name(*format)) : std::string());
 
   remesh::api::UploadLimits limits;
   limits.max_faces = options.max_faces;
@@ -614,6 +615,9 @@ void HttpServer::Impl::post_job(const httplib::Request& req, httplib::Response& 
     return;
   }
   JobRecord& record = prepared->record;
+  // An upload without a name whose format was sniffed from its bytes is named by that format, as
+  // one with a Content-Type is ("mesh.stl", not "mesh").
+  if (!named && !format) record.filename = "mesh." + record.format;
   switch (jobs.submit(record, body)) {
     case JobManager::Submit::QueueFull:
       res.set_header("Retry-After", "10");

@@ -78,6 +78,8 @@ TEST_CASE("remeshd: submit raw and multipart, follow, download, list, delete", "
   auto s = submit_raw(c, mesh, "emin=0.2&emax=0.35&iterations=2", "application/octet-stream");
   REQUIRE(s);
   CHECK(s->status == 202);
+  CHECK(body_of(s)["input"]["format"] == "obj");
+  CHECK(body_of(s)["input"]["filename"] == "mesh.obj");  // named by the sniffed format
   const std::string id3 = body_of(s)["id"];
 
   json done = wait_final(c, id);
