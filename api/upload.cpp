@@ -155,7 +155,9 @@ PreparedJob prepare_job(std::string_view bytes, std::string_view filename, std::
   r.id = new_job_id();
   r.state = JobState::Queued;
   r.created_at = now_seconds();
-  r.params = params.params;
+  // As the run takes them (e_max at most the bounding-box diagonal), so that the document says what
+  // ran: an e_max of 1e300 showed as such, and the dual's bond interval as [0.29, 5.8e299].
+  r.params = as_run(job.mesh.mesh, params.params);
   r.weld = params.weld;
   r.filename = utf8_prefix(filename, 200);
   r.format = std::string(format_name(job.mesh.format));

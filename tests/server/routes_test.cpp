@@ -478,7 +478,11 @@ TEST_CASE("remeshd: parameters and names that once crashed the service or gave 5
   REQUIRE(big);
   REQUIRE(big->status == 202);
   const std::string big_id = body_of(big)["id"];
-  CHECK(wait_final(c, big_id)["state"] == "succeeded");
+  // The document gives e_max as the run takes it: the bounding-box diagonal of the ball.
+  CHECK(body_of(big)["params"]["emax"].get<double>() == Approx(body_of(big)["input"]["summary"]["bbox"]["diagonal"].get<double>()));
+  const json big_done = wait_final(c, big_id);
+  CHECK(big_done["state"] == "succeeded");
+  CHECK(big_done["dual"]["bond_interval"][1].get<double>() < 10);
   CHECK(c.Get("/healthz")->status == 200);
   // A byte range of a result is a 206 with those bytes (cpp-httplib kept the handler's 200).
   const std::string url = "/api/v1/jobs/" + big_id + "/result?mesh=remeshed&format=obj";
