@@ -80,6 +80,14 @@ async function main() {
   await page.fill('#tolerance', '20');
   check(await page.textContent('#helper-error') === '', 'editing ± % clears its message');
 
+  // --- a decimal comma typed into a number field is a point (Chromium read "0,5" as 5) ---
+  const target_before = await page.inputValue('#target');
+  await page.fill('#target', '');
+  await page.type('#target', '0,5');
+  const typed = await page.$eval('#target', (i) => [i.value, i.valueAsNumber]);
+  check(typed[0] === '0.5' && typed[1] === 0.5, `"0,5" typed into a number field reads 0.5 (got ${JSON.stringify(typed)})`);
+  await page.fill('#target', target_before);
+
   // --- a local check in the page's terms (labels, not API names) ---
   await page.fill('#emax', String(filled.emin / 2));
   await page.click('#submit');

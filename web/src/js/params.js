@@ -115,10 +115,26 @@ function clear_on_edit() {
   });
 }
 
+/// A decimal comma typed or pasted into a number field becomes a point. Chromium's number inputs
+/// drop the comma of "0,04" (the value read as 4) in every locale, silently.
+function decimal_comma() {
+  const insert = (text) => document.execCommand('insertText', false, text);
+  for (const input of document.querySelectorAll('input[type=number]')) {
+    input.addEventListener('keydown', (e) => {
+      if (e.key === ',' && !e.ctrlKey && !e.metaKey && !e.altKey && insert('.')) e.preventDefault();
+    });
+    input.addEventListener('paste', (e) => {
+      const text = e.clipboardData?.getData('text') ?? '';
+      if (/^\s*[-+]?\d*,\d+(e[-+]?\d+)?\s*$/i.test(text) && insert(text.trim().replace(',', '.'))) e.preventDefault();
+    });
+  }
+}
+
 /// The helper: target mean ± tolerance % -> emin/emax. `on_change` runs after the form changed.
 /// A wrong target or tolerance is named beside the helper instead of being replaced by a default.
 export function init_helper(on_change) {
   clear_on_edit();
+  decimal_comma();
   const error = $('helper-error');
   const complain = (field, text) => {
     for (const id of ['target', 'tolerance']) {
