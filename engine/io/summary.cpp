@@ -12,6 +12,14 @@
 
 namespace remesh {
 
+namespace {
+
+/// |d| without overflow: a mesh 1e300 across has edges and a diagonal a double holds, whose
+/// squares it does not (they read "inf"). Its area is another matter: 1e600 is no double.
+double length(const Vec3& d) { return std::hypot(d[0], d[1], d[2]); }
+
+}  // namespace
+
 MeshSummary summarize(const TriMesh& mesh) {
   MeshSummary s;
   const std::size_t nv = mesh.n_vertices();
@@ -26,7 +34,7 @@ MeshSummary summarize(const TriMesh& mesh) {
     const std::size_t a = find_root(parent, static_cast<std::size_t>(mesh.from_vertex_handle(h).idx()));
     const std::size_t b = find_root(parent, static_cast<std::size_t>(mesh.to_vertex_handle(h).idx()));
     if (a != b) parent[std::max(a, b)] = std::min(a, b);
-    const double len = mesh.calc_edge_length(e);
+    const double len = length(mesh.point(mesh.to_vertex_handle(h)) - mesh.point(mesh.from_vertex_handle(h)));
     edge_sum += len;
     s.min_edge = std::min(s.min_edge, len);
     s.max_edge = std::max(s.max_edge, len);
@@ -54,7 +62,7 @@ MeshSummary summarize(const TriMesh& mesh) {
     s.bbox_max.maximize(p);
   }
   s.components = s.per_component.size();
-  s.bbox_diagonal = (s.bbox_max - s.bbox_min).norm();
+  s.bbox_diagonal = length(s.bbox_max - s.bbox_min);
   auto comp_of = [&](TriMesh::VertexHandle v) -> ComponentSummary& {
     return s.per_component[component[static_cast<std::size_t>(v.idx())]];
   };

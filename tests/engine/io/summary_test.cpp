@@ -79,3 +79,17 @@ TEST_CASE("Summary of an open grid and of several components") {
   CHECK(s.per_component[2].genus == 1);
   CHECK(s.per_component[2].faces == 96);
 }
+
+TEST_CASE("Summary of a mesh 1e300 across: lengths a double holds are not overflowed squares") {
+  const LoadedMesh m = read_mesh("v 0 0 0\nv 1e300 0 0\nv 0 1e300 0\nv 0 0 1e300\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n",
+                                 ReadOptions{Format::Obj});
+  const MeshSummary s = summarize(m.mesh);
+  CHECK(s.bbox_diagonal == Approx(std::sqrt(3.0) * 1e300));
+  CHECK(s.min_edge == Approx(1e300));
+  CHECK(s.max_edge == Approx(std::sqrt(2.0) * 1e300));
+  CHECK(std::isfinite(s.mean_edge));
+  // The same lengths as before on an ordinary mesh.
+  const MeshSummary unit = summarize(test::make_icosphere(1));
+  CHECK(unit.bbox_diagonal == Approx(2 * std::sqrt(3.0)).epsilon(0.2));
+  CHECK(unit.min_edge > 0);
+}
