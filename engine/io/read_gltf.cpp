@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cstdio>
 #include <cstring>
 #include <cmath>
 #include <stdexcept>
@@ -168,6 +169,12 @@ class Collector {
     for (std::size_t i = 0; i < pv.count; ++i) {
       float c[3];
       std::memcpy(c, pv.base + i * pv.stride, 12);
+      // Named as stored: the node transform would spread one NaN to all three coordinates.
+      if (!std::isfinite(c[0]) || !std::isfinite(c[1]) || !std::isfinite(c[2])) {
+        char coords[96];
+        std::snprintf(coords, sizeof coords, "(%g, %g, %g)", c[0], c[1], c[2]);
+        fail("glTF: " + what + " POSITION element " + std::to_string(i) + " has a non-finite coordinate " + coords);
+      }
       Vec3 p;
       for (int r = 0; r < 3; ++r) p[r] = m[r] * c[0] + m[4 + r] * c[1] + m[8 + r] * c[2] + m[12 + r];
       soup_.points.push_back(p);

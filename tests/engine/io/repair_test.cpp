@@ -2,6 +2,7 @@
 #include <catch2/catch.hpp>
 
 #include <cstdint>
+#include <limits>
 #include <random>
 
 #include "io/mesh_io.h"
@@ -31,11 +32,14 @@ std::string error_of(const std::string& bytes, const ReadOptions& o) {
 }
 
 /// A GLB tetrahedron: 4 positions, then an index accessor of `index_count` unsigned shorts in a
-/// bufferView that holds its 12.
-std::string tetra_glb(std::size_t index_count) {
+/// bufferView that holds its 12. With `nan_at` (0-11), that coordinate of the positions is NaN.
+std::string tetra_glb(std::size_t index_count, int nan_at = -1) {
   std::string bin;
-  for (float v : {0.f, 0.f, 0.f, 1.f, 0.f, 0.f, 0.f, 1.f, 0.f, 0.f, 0.f, 1.f})
+  int k = 0;
+  for (float v : {0.f, 0.f, 0.f, 1.f, 0.f, 0.f, 0.f, 1.f, 0.f, 0.f, 0.f, 1.f}) {
+    if (k++ == nan_at) v = std::numeric_limits<float>::quiet_NaN();
     bin.append(reinterpret_cast<const char*>(&v), 4);
+  }
   for (std::uint16_t i : {0, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3}) bin.append(reinterpret_cast<const char*>(&i), 2);
   std::string json = R"({"asset":{"version":"2.0"},"scene":0,"scenes":[{"nodes":[0]}],"nodes":[{"mesh":0}],
     "meshes":[{"primitives":[{"attributes":{"POSITION":0},"indices":1}]}],
@@ -105,6 +109,8 @@ TEST_CASE("Non-finite coordinates are refused with the vertex index and line") {
   CHECK_THROWS_WITH(read("OFF\n3 1 0\n0 0 0\n1 0 0\n0 inf 0\n3 0 1 2\n"),
                     Contains("vertex 2 (line 5)") && Contains("non-finite"));
   CHECK_THROWS_WITH(read("v 0 0 0\nv 1e999 0 0\nv 0 1 0\nf 1 2 3\n"), Contains("vertex 1 (line 2)"));
+  // glTF: the coordinate as stored, before the node transform spreads the NaN ("(nan, nan, nan)").
+  CHECK_THROWS_WITH(read_mesh(tetra_glb(12, 4)), Contains("POSITION element 1 has a non-finite coordinate (1, nan, 0)"));
 }
 
 TEST_CASE("Face indices out of range are refused with the face and line") {
