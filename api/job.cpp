@@ -10,6 +10,15 @@
 
 #include "json_codec.h"
 
+namespace remesh {
+
+/// The job's "triangles" (triangle_quality.h): its fields by their own names. Angles in degrees;
+/// below_30 and above_90 are fractions of the faces.
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(TriangleQuality, faces, min_angle, max_angle, below_30, above_90,
+                                   min_radius_ratio, mean_radius_ratio)
+
+}  // namespace remesh
+
 namespace remesh::api {
 
 using nlohmann::json;
@@ -74,30 +83,6 @@ json thin_parts_to_json(const ThinParts& t) {
                 {"thinner", {{"vertices", t.vertices_thinner}, {"regular", t.regular_thinner}}},
                 {"thicker", {{"vertices", t.vertices_thicker}, {"regular", t.regular_thicker}}},
                 {"sampled", t.sampled}}}};
-}
-
-/// {faces, min_angle, max_angle, below_30, above_90, min_radius_ratio, mean_radius_ratio}
-/// (triangle_quality.h; angles in degrees, below_30 and above_90 fractions of the faces).
-json triangles_to_json(const TriangleQuality& t) {
-  return json{{"faces", t.faces},
-              {"min_angle", t.min_angle},
-              {"max_angle", t.max_angle},
-              {"below_30", t.below_30},
-              {"above_90", t.above_90},
-              {"min_radius_ratio", t.min_radius_ratio},
-              {"mean_radius_ratio", t.mean_radius_ratio}};
-}
-
-TriangleQuality triangles_from_json(const json& j) {
-  TriangleQuality t;
-  t.faces = j.at("faces").get<std::size_t>();
-  t.min_angle = j.at("min_angle").get<double>();
-  t.max_angle = j.at("max_angle").get<double>();
-  t.below_30 = j.at("below_30").get<double>();
-  t.above_90 = j.at("above_90").get<double>();
-  t.min_radius_ratio = j.at("min_radius_ratio").get<double>();
-  t.mean_radius_ratio = j.at("mean_radius_ratio").get<double>();
-  return t;
 }
 
 /// {atoms, bonds, rings: {"5": n, "6": n, ...}, bond_length: {mean, deviation, min, max},
@@ -216,7 +201,7 @@ json job_to_json(const JobRecord& job, std::string_view prefix, double now) {
       {"outcome", job.outcome ? json(*job.outcome) : json(nullptr)},
       {"thin_parts", job.thin_parts ? thin_parts_to_json(*job.thin_parts) : json(nullptr)},
       {"crossing_pairs", job.crossing_pairs ? json(*job.crossing_pairs) : json(nullptr)},
-      {"triangles", job.triangles ? triangles_to_json(*job.triangles) : json(nullptr)},
+      {"triangles", job.triangles ? json(*job.triangles) : json(nullptr)},
       {"seconds_by_step", job.seconds_by_step ? step_seconds_to_json(*job.seconds_by_step) : json(nullptr)},
       {"dual", job.dual ? dual_to_json(*job.dual) : json(nullptr)},
       {"error", job.error ? json(*job.error) : json(nullptr)},
@@ -272,7 +257,7 @@ JobRecord job_from_json(const json& j) {
     if (const auto c = j.find("crossing_pairs"); c != j.end() && !c->is_null())
       job.crossing_pairs = c->get<std::size_t>();
     // Absent in documents written before the field existed.
-    if (const auto t = j.find("triangles"); t != j.end() && !t->is_null()) job.triangles = triangles_from_json(*t);
+    if (const auto t = j.find("triangles"); t != j.end() && !t->is_null()) job.triangles = t->get<TriangleQuality>();
     if (const auto t = j.find("seconds_by_step"); t != j.end() && !t->is_null())
       job.seconds_by_step = step_seconds_from_json(*t);
     // Absent in documents written before the field existed.

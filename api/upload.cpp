@@ -159,8 +159,10 @@ PreparedJob prepare_job(std::string_view bytes, std::string_view filename, std::
   // ran: an e_max of 1e300 showed as such, and the dual's bond interval as [0.29, 5.8e299].
   r.params = as_run(job.mesh.mesh, params.params);
   r.weld = params.weld;
-  r.filename = utf8_prefix(filename, 200);
   r.format = std::string(format_name(job.mesh.format));
+  // An upload without a name is named by the format it was read in (from the Content-Type or its
+  // bytes): "mesh.stl".
+  r.filename = filename.empty() ? "mesh." + r.format : utf8_prefix(filename, 200);
   r.bytes = bytes.size();
   r.summary = summarize(job.mesh.mesh);
   r.repairs = job.mesh.repairs;

@@ -55,6 +55,7 @@ struct PreparedJob {
 
 /// Validates parameters (ParamsError with every bad field, before reading), reads the mesh
 /// (MeshError with the reader's message), checks faces and estimated output faces (LimitError).
+/// An empty `filename` becomes "mesh.<format read>".
 PreparedJob prepare_job(std::string_view bytes, std::string_view filename, std::optional<Format> format,
                         ParsedParams params, const UploadLimits& limits);
 

@@ -59,6 +59,8 @@ void send_bytes(const httplib::Request& req, httplib::Response& res, std::string
 constexpr const char* kPrefix = "/api/v1";
 constexpr std::size_t kMiB = 1024 * 1024;
 constexpr std::size_t kMaxParamsBytes = 64 * 1024;
+/// The query keys of POST /jobs that are not job parameters.
+const std::vector<std::string> kUploadQueryKeys = {"format", "filename", "access_token"};
 /// The most header bytes (names, values and their separators) a request may carry.
 constexpr std::size_t kMaxHeaderBytes = 64 * 1024;
 
@@ -133,11 +135,10 @@ std::vector<FieldError> repeated_query_keys(const httplib::Request& req) {
   return errors;
 }
 
-/// Keys that an object of the JSON text holds more than once ({"emin": 1, "emin": 2}: nlohmann
-/// keeps the last silently). Empty for text that does not parse.
-std::vector<std::string> repeated_json_keys(const std::string& text) {
+/// The JSON text parsed (discarded when it does not parse), with the keys that an object of it
+/// holds more than once in `repeated` ({"emin": 1, "emin": 2}: nlohmann keeps the last silently).
+json parse_noting_repeats(const std::string& text, std::vector<std::string>& repeated) {
   std::vector<std::vector<std::string>> open;  // the keys of each object being read
-  std::vector<std::string> repeated;
   auto seen = [&](int, json::parse_event_t event, json& parsed) {
     if (event == json::parse_event_t::object_start) open.emplace_back();
     else if (event == json::parse_event_t::object_end && !open.empty()) open.pop_back();
@@ -152,8 +153,9 @@ std::vector<std::string> repeated_json_keys(const std::string& text) {
     }
     return true;
   };
-  if (json::parse(text, seen, false).is_discarded()) return {};
-  return repeated;
+  json parsed = json::parse(text, seen, false);
+  if (parsed.is_discarded()) repeated.clear();
+  return parsed;
 }
 
 /// Query parameters as a map (first value of each), minus the ones that are not job parameters.
@@ -565,24 +567,25 @@ void HttpServer::Impl::post_job(const httplib::Request& req, httplib::Response& 
     if (parts > 1)
       errors.push_back({name, "was sent " + std::to_string(parts) + " times; a job takes one (one remesh job per request)"});
   if (params_parts > 0) {
-    json j = json::parse(params_text, nullptr, false);
+    std::vector<std::string> repeated;
+    const json j = parse_noting_repeats(params_text, repeated);
     if (params_too_big) errors.push_back({"params", "is larger than 64 KiB"});
     else if (j.is_discarded()) errors.push_back({"params", "is not valid JSON"});
     else if (!j.is_object()) errors.push_back({"params", "must be a JSON object of the job's parameters"});
     else parsed = remesh::params_from_json(j);
-    for (const std::string& key : repeated_json_keys(params_text))
+    for (const std::string& key : repeated)
       errors.push_back({"params." + key.substr(0, 64), "is given more than once; give it once"});
     // The job's parameters come from one place: with a params part, the query holds none.
     const auto& names = remesh::param_names();
     for (const auto& [key, value] : req.params) {
-      if (key == "format" || key == "filename" || key == "access_token") continue;
+      if (std::find(kUploadQueryKeys.begin(), kUploadQueryKeys.end(), key) != kUploadQueryKeys.end()) continue;
       const bool param = std::find(names.begin(), names.end(), key) != names.end();
       errors.push_back({key.substr(0, 64), param ? "is in the query and there is a params part: give every parameter in "
                                                    "the params part"
                                                  : "unknown parameter"});
     }
   } else {
-    parsed = remesh::params_from_query(query_params(req), {"format", "filename", "access_token"});
+    parsed = remesh::params_from_query(query_params(req), kUploadQueryKeys);
   }
   if (req.is_multipart_form_data() && mesh_parts == 0) errors.push_back({"mesh", "is required (a file field named 'mesh')"});
   else if (body.empty()) errors.push_back({"mesh", "is empty"});
@@ -594,8 +597,6 @@ void HttpServer::Impl::post_job(const httplib::Request& req, httplib::Response& 
     send_problem(res, 422, "invalid request: see errors", errors);
     return;
   }
-  const bool named = !filename.empty();
-  if (!named) filename = "mesh" + (format ? "." + std::string(remesh::format_name(*format)) : std::string());
 
   remesh::api::UploadLimits limits;
   limits.max_faces = options.max_faces;
@@ -615,9 +616,6 @@ void HttpServer::Impl::post_job(const httplib::Request& req, httplib::Response& 
     return;
   }
   JobRecord& record = prepared->record;
-  // An upload without a name whose format was sniffed from its bytes is named by that format, as
-  // one with a Content-Type is ("mesh.stl", not "mesh").
-  if (!named && !format) record.filename = "mesh." + record.format;
   switch (jobs.submit(record, body)) {
     case JobManager::Submit::QueueFull:
       res.set_header("Retry-After", "10");

@@ -23,7 +23,8 @@ TriangleQuality triangle_quality(const TriMesh& mesh) {
     const auto h = mesh.halfedge_handle(f);
     const Vec3 a = mesh.point(mesh.from_vertex_handle(h)), b = mesh.point(mesh.to_vertex_handle(h)),
                c = mesh.point(mesh.to_vertex_handle(mesh.next_halfedge_handle(h)));
-    const double angles[3] = {angle_between(b - a, c - a), angle_between(c - b, a - b), angle_between(a - c, b - c)};
+    const double at_a = angle_between(b - a, c - a), at_b = angle_between(c - b, a - b);
+    const double angles[3] = {at_a, at_b, 180 - at_a - at_b};
     const double lo = std::min({angles[0], angles[1], angles[2]}), hi = std::max({angles[0], angles[1], angles[2]});
     smallest = std::min(smallest, lo);
     largest = std::max(largest, hi);
