@@ -44,6 +44,35 @@ void try_variant(const std::string& bytes, std::optional<Format> format, const s
   }
 }
 
+/// Reads `bytes` truncated (every length near both ends, ~150 between) and with 1 to 4 bytes
+/// changed (300 variants), given their format or not, some welded.
+void garble(const std::string& bytes, Format format, const std::string& name, std::mt19937& rng,
+            Outcome& outcome) {
+  const std::size_t n = bytes.size();
+  // Truncations: every length near both ends, then ~150 spread over the file.
+  for (std::size_t len = 0; len < n; len += (len < 64 || len + 64 > n) ? 1 : std::max<std::size_t>(1, n / 150)) {
+    const std::string cut = bytes.substr(0, len);
+    try_variant(cut, len % 2 ? std::optional<Format>(format) : std::nullopt,
+                name + " truncated to " + std::to_string(len), outcome);
+  }
+  // Byte flips: 1 to 4 random bytes set to random values (half of them to "interesting" ones).
+  const unsigned char interesting[] = {0, 0xff, 0x7f, 0x80, '0', '9', '-', '.', 'e', ' ', '\n', '/', '#', '"', '{'};
+  for (int variant = 0; variant < 300; ++variant) {
+    std::string bad = bytes;
+    const int flips = 1 + variant % 4;
+    std::string where;
+    for (int k = 0; k < flips; ++k) {
+      const std::size_t at = std::uniform_int_distribution<std::size_t>(0, n - 1)(rng);
+      const unsigned v = rng();
+      bad[at] = static_cast<char>(v % 2 ? interesting[(v >> 1) % sizeof interesting] : (v >> 8) & 0xff);
+      where += ' ';
+      where += std::to_string(at);
+    }
+    try_variant(bad, variant % 3 ? std::optional<Format>(format) : std::nullopt,
+                name + " with bytes changed at" + where, outcome, variant % 4 == 1);
+  }
+}
+
 }  // namespace
 
 TEST_CASE("Garbled files give an error or a valid mesh") {
@@ -55,32 +84,37 @@ TEST_CASE("Garbled files give an error or a valid mesh") {
     // The intact file reads.
     try_variant(file.bytes, file.format, file.name + " intact", outcome);
     REQUIRE(outcome.meshes == 1);
-    const std::size_t n = file.bytes.size();
-    // Truncations: every length near both ends, then ~150 spread over the file.
-    for (std::size_t len = 0; len < n; len += (len < 64 || len + 64 > n) ? 1 : std::max<std::size_t>(1, n / 150)) {
-      const std::string cut = file.bytes.substr(0, len);
-      try_variant(cut, len % 2 ? std::optional<Format>(file.format) : std::nullopt,
-                  file.name + " truncated to " + std::to_string(len), outcome);
-    }
-    // Byte flips: 1 to 4 random bytes set to random values (half of them to "interesting" ones).
-    const unsigned char interesting[] = {0, 0xff, 0x7f, 0x80, '0', '9', '-', '.', 'e', ' ', '\n', '/', '#', '"', '{'};
-    for (int variant = 0; variant < 300; ++variant) {
-      std::string bad = file.bytes;
-      const int flips = 1 + variant % 4;
-      std::string where;
-      for (int k = 0; k < flips; ++k) {
-        const std::size_t at = std::uniform_int_distribution<std::size_t>(0, n - 1)(rng);
-        const unsigned v = rng();
-        bad[at] = static_cast<char>(v % 2 ? interesting[(v >> 1) % sizeof interesting] : (v >> 8) & 0xff);
-        where += ' ';
-        where += std::to_string(at);
-      }
-      try_variant(bad, variant % 3 ? std::optional<Format>(file.format) : std::nullopt,
-                  file.name + " with bytes changed at" + where, outcome, variant % 4 == 1);
-    }
+    garble(file.bytes, file.format, file.name, rng, outcome);
     CHECK(outcome.errors > 0);
     CHECK(outcome.meshes > 1);
   }
+}
+
+TEST_CASE("Garbled OFF with its records wrapped over lines gives an error or a valid mesh") {
+  // An icosphere's ASCII OFF with every value on a line of its own (the counts too), a comment and
+  // a blank line after every 7th: the reader carries records over lines, here under ASan too.
+  const PolygonSoup soup = to_soup(test::make_icosphere(1));
+  const std::string off = write_mesh(soup, Format::Off);
+  REQUIRE(off.rfind("OFF\n", 0) == 0);
+  std::string wrapped = "OFF\n";
+  std::size_t spaces = 0;
+  for (char c : off.substr(4)) {
+    if (c == ' ')
+      wrapped += ++spaces % 7 ? "\n" : " # wrapped\n\n";
+    else
+      wrapped += c;
+  }
+  REQUIRE(spaces > 300);
+  const LoadedMesh plain = read_mesh(off);
+  LoadedMesh m;
+  REQUIRE_NOTHROW(m = read_mesh(wrapped));
+  REQUIRE(m.mesh.n_faces() == plain.mesh.n_faces());
+  for (auto v : plain.mesh.vertices()) CHECK(m.mesh.point(v) == plain.mesh.point(v));
+  std::mt19937 rng(20260311);
+  Outcome outcome;
+  garble(wrapped, Format::Off, "wrapped off", rng, outcome);
+  CHECK(outcome.errors > 0);
+  CHECK(outcome.meshes > 1);
 }
 
 TEST_CASE("Vertices snapped onto a neighbour or an edge give a valid mesh without zero-area faces") {

@@ -1,6 +1,9 @@
 // Reading each input format, with the format-specific details the readers must handle.
 #include <catch2/catch.hpp>
 
+#include <array>
+#include <vector>
+
 #include "io/mesh_io.h"
 #include "io/summary.h"
 #include "io_test_util.h"
@@ -31,6 +34,52 @@ const std::string kCubeObj =
     "f -7 -6 -2 -3\r\n"  // 2 3 7 6 through negative indices
     "f 3 4 8 7\r\n"
     "f 4 1 5 8\r\n";
+
+/// A cube with a distinct value for each coordinate, as OFF: `header` (keyword and counts), then
+/// its vertex and face records, the values of each joined by the separators given (vsep[k] after value k of a
+/// vertex, fsep[k] after value k of a face: its vertex count, then indices) and ended by `end`.
+std::string cube_off(const std::string& header, const std::array<std::string, 2>& vsep,
+                     const std::array<std::string, 4>& fsep, const std::string& end = "\n") {
+  static const char* const xs[2] = {"-1", "2.5"};
+  static const char* const ys[2] = {"-1.25", "3"};
+  static const char* const zs[2] = {"0.5", "4.75"};
+  static const int corners[8][3] = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0},
+                                    {0, 0, 1}, {1, 0, 1}, {1, 1, 1}, {0, 1, 1}};
+  static const int quads[6][4] = {{0, 3, 2, 1}, {4, 5, 6, 7}, {0, 1, 5, 4},
+                                  {1, 2, 6, 5}, {2, 3, 7, 6}, {3, 0, 4, 7}};
+  std::string out = header;
+  for (const auto& c : corners)
+    out += std::string(xs[c[0]]) + vsep[0] + ys[c[1]] + vsep[1] + zs[c[2]] + end;
+  for (const auto& q : quads)
+    out += "4" + fsep[0] + std::to_string(q[0]) + fsep[1] + std::to_string(q[1]) + fsep[2] +
+           std::to_string(q[2]) + fsep[3] + std::to_string(q[3]) + end;
+  return out;
+}
+
+const std::string kCubeOff = cube_off("OFF\n8 6 12\n", {" ", " "}, {" ", " ", " ", " "});
+
+/// The same points, in order, and the same faces, vertex by vertex.
+void check_same_mesh(const LoadedMesh& got, const LoadedMesh& want) {
+  REQUIRE(got.mesh.n_vertices() == want.mesh.n_vertices());
+  REQUIRE(got.mesh.n_faces() == want.mesh.n_faces());
+  for (auto v : want.mesh.vertices()) CHECK(got.mesh.point(v) == want.mesh.point(v));
+  for (auto f : want.mesh.faces()) {
+    std::vector<int> a, b;
+    for (auto v : got.mesh.fv_range(f)) a.push_back(v.idx());
+    for (auto v : want.mesh.fv_range(f)) b.push_back(v.idx());
+    CHECK(a == b);
+  }
+}
+
+/// The message of the MeshError that reading `bytes` throws ("" if it reads).
+std::string read_error(const std::string& bytes) {
+  try {
+    read_as(bytes);
+  } catch (const MeshError& e) {
+    return e.what();
+  }
+  return "";
+}
 
 }  // namespace
 
@@ -76,6 +125,114 @@ TEST_CASE("OFF: ASCII with comments, colours and counts on the header line, bina
   CHECK(b.format == Format::Off);
   CHECK(b.mesh.n_faces() == 80);
   CHECK(b.repairs.empty());
+}
+
+TEST_CASE("OFF: records wrapped over lines read as the one-record-per-line file") {
+  const LoadedMesh plain = read_as(kCubeOff);
+  REQUIRE(plain.mesh.n_vertices() == 8);
+  REQUIRE(plain.mesh.n_faces() == 12);
+  CHECK(plain.mesh.point(plain.mesh.vertex_handle(6)) == Vec3(2.5, 3, 4.75));
+  const std::array<std::string, 2> v1 = {" ", " "};
+  const std::array<std::string, 4> f1 = {" ", " ", " ", " "};
+  const std::pair<const char*, std::string> variants[] = {
+      {"faces wrapped after each index", cube_off("OFF\n8 6 12\n", v1, {"\n", "\n", "\n", "\n"})},
+      {"faces wrapped, comments and blank lines between the pieces",
+       cube_off("OFF\n8 6 12\n", v1, {" # count\n", "\n\n", " # 2nd\n# comment\n", "\t\r\n  \n"})},
+      {"vertices split after x", cube_off("OFF\n8 6 12\n", {"\n", " "}, f1)},
+      {"vertices split after y, comments between", cube_off("OFF\n8 6 12\n", {" ", " # z next\n\n"}, f1)},
+      {"vertices one value a line, CRLF", cube_off("OFF\r\n8 6 12\r\n", {"\r\n", "\r\n"}, f1, "\r\n")},
+      {"counts split", cube_off("OFF\n8\n6 0\n", v1, f1)},
+      {"counts after the keyword, split", cube_off("OFF 8\n6 12\n", v1, f1)},
+      {"counts one a line, comments between", cube_off("OFF\n8\n# faces\n\n6 # then edges\n12\n", v1, f1)},
+      {"edge count on its own line", cube_off("OFF 8 6\n12\n", v1, f1)},
+      // The first value, -1, alone on the line after the counts: a vertex's, since the next line
+      // does not hold a whole vertex.
+      {"vertices one value a line, no edge count", cube_off("OFF\n8 6\n", {"\n", "\n"}, f1)},
+      {"all wrapped", cube_off("OFF # cube\n8\n\n6\n12 # edges\n", {"\n# y\n", "\n"},
+                               {"\n", " ", "\n\n", "\n# last\n"})},
+  };
+  for (const auto& [what, text] : variants) {
+    CAPTURE(what, text);
+    LoadedMesh wrapped;
+    REQUIRE_NOTHROW(wrapped = read_as(text));
+    CHECK(wrapped.format == Format::Off);
+    check_same_mesh(wrapped, plain);
+  }
+}
+
+TEST_CASE("OFF: extra values after a wrapped record's last value stay ignored") {
+  const LoadedMesh plain = read_as(kCubeOff);
+  // COFF colours after the 3rd coordinate, a face colour after the last index, on the line where
+  // the record completes.
+  const std::string coff = cube_off("COFF\n8 6 12\n", {"\n", " "}, {" ", "\n", " ", "\n"}, " 0.5 0.25 1 1\n");
+  check_same_mesh(read_as(coff), plain);
+  // NOFF normals on the completing line.
+  const std::string noff = cube_off("NOFF\n8 6 12\n", {" ", "\n"}, {"\n", " ", " ", " "}, " 0 0 1\n");
+  check_same_mesh(read_as(noff), plain);
+}
+
+TEST_CASE("OFF: files read before wrapping was accepted read the same") {
+  const LoadedMesh plain = read_as(kCubeOff);
+  // Colours and normals after the coordinates, face colours after the indices, counts on the
+  // keyword line, no edge count: the extra values are not taken as the next record.
+  const std::array<std::string, 2> v1 = {" ", " "};
+  const std::array<std::string, 4> f1 = {" ", " ", " ", " "};
+  const std::pair<const char*, std::string> variants[] = {
+      {"COFF with vertex and face colours", cube_off("COFF\n8 6 12\n", v1, f1, " 255 0 0 255\n")},
+      {"NOFF", cube_off("NOFF\n8 6 12\n", v1, f1, " 0 0 1\n")},
+      {"counts on the keyword line", cube_off("OFF 8 6 12 # cube\n", v1, f1)},
+      {"no edge count", cube_off("OFF\n8 6\n", v1, f1)},
+      {"no edge count, after the keyword", cube_off("OFF 8 6\n", v1, f1)},
+  };
+  for (const auto& [what, text] : variants) {
+    CAPTURE(what, text);
+    LoadedMesh m;
+    REQUIRE_NOTHROW(m = read_as(text));
+    check_same_mesh(m, plain);
+  }
+  // The tetrahedron with a face colour of one value on a face of three: 4 faces, not a 4-gon.
+  const LoadedMesh t = read_as("OFF\n4 4 6\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1 7\n3 0 1 3\n3 0 3 2\n3 1 2 3\n");
+  CHECK(t.mesh.n_faces() == 4);
+  CHECK(t.repairs.empty());
+}
+
+TEST_CASE("OFF: wrapped records cut short or with a bad value are refused, naming the line and the problem") {
+  using Catch::Contains;
+  // (The comment leaves the bytes that the header's size check wants: 5 a vertex, 7 a face.)
+  const std::string tri = "OFF\n3 1 0\n0 0 0 # a triangle, its last vertex and face wrapped or cut\n1 0 0\n";
+  CHECK_NOTHROW(read_as(tri + "0\n1 0\n3 0\n1\n2\n"));
+  CHECK(read_error(tri + "0 1\n") == "OFF line 5: vertex 2 has fewer than 3 coordinates (the file ends after 2)");
+  CHECK(read_error(tri + "0\n# 1 0\n\n") == "OFF line 5: vertex 2 has fewer than 3 coordinates (the file ends after 1)");
+  CHECK(read_error(tri + "0 1 0\n3 0\n# 1\n1\n") ==
+        "OFF line 6: face 0 declares 3 vertices but the file ends after 2");
+  CHECK(read_error(tri + "0 1 0\n3\n") == "OFF line 6: face 0 declares 3 vertices but the file ends after 0");
+  CHECK(read_error(tri) == "OFF: file ends after 2 of 3 vertices");
+  CHECK(read_error(tri + "0 1 0\n") == "OFF: file ends after 0 of 1 faces");
+  CHECK(read_error("OFF\n") == "OFF: missing the vertex/face count line");
+  CHECK(read_error("OFF\n3 # faces next\n\n") == "OFF line 2: missing face count");
+  // A bad value in a continuation: its own line.
+  CHECK_THAT(read_error(tri + "0\n1 x\n3 0 1 2\n"), Contains("OFF line 6") && Contains("bad coordinate 'x' of vertex 2"));
+  CHECK_THAT(read_error(tri + "0 1 0\n3 0\n1 y\n"), Contains("OFF line 7") && Contains("bad vertex index 'y' in face 0"));
+  CHECK_THAT(read_error("OFF\n3\nz 0\n"), Contains("OFF line 3") && Contains("bad face count 'z'"));
+  // A value missing inside the file: the vertex takes the next line's first value, and the file
+  // ends early, with the record that was continued named.
+  CHECK(read_error("OFF\n3 1 0\n0 0 0\n1 0\n0 1 0\n3 0 1 2\n") ==
+        "OFF: file ends after 0 of 1 faces (vertex 1 at line 4 is the first record continued on the next line)");
+  // A face declaring more indices than it lists, at the end: as before.
+  CHECK_THAT(read_error(tri + "0 1 0\n4 0 1 2\n"), Contains("OFF line 6") && Contains("declares 4"));
+
+  // The wrapped cube cut after each of its lines: refused, saying the file ends or is short.
+  const std::string wrapped = cube_off("OFF 8\n6\n12\n", {"\n", "\n"}, {"\n", " # i\n", "\n\n", "\n"});
+  REQUIRE_NOTHROW(read_as(wrapped));
+  std::size_t cuts = 0;
+  for (std::size_t at = wrapped.find('\n'); at + 1 < wrapped.size(); at = wrapped.find('\n', at + 1)) {
+    const std::string message = read_error(wrapped.substr(0, at + 1));
+    CAPTURE(at, message);
+    CHECK((message.find("ends after") != std::string::npos || message.find("missing") != std::string::npos ||
+           message.find("header claims") != std::string::npos));
+    ++cuts;
+  }
+  CHECK(cuts > 60);
 }
 
 TEST_CASE("PLY: ascii, both binary byte orders, extra properties and elements") {
