@@ -201,6 +201,7 @@ json job_to_json(const JobRecord& job, std::string_view prefix, double now) {
       {"outcome", job.outcome ? json(*job.outcome) : json(nullptr)},
       {"thin_parts", job.thin_parts ? thin_parts_to_json(*job.thin_parts) : json(nullptr)},
       {"crossing_pairs", job.crossing_pairs ? json(*job.crossing_pairs) : json(nullptr)},
+      {"layered", job.layered},
       {"triangles", job.triangles ? json(*job.triangles) : json(nullptr)},
       {"seconds_by_step", job.seconds_by_step ? step_seconds_to_json(*job.seconds_by_step) : json(nullptr)},
       {"dual", job.dual ? dual_to_json(*job.dual) : json(nullptr)},
@@ -256,6 +257,7 @@ JobRecord job_from_json(const json& j) {
     // Absent in documents written before the field existed.
     if (const auto c = j.find("crossing_pairs"); c != j.end() && !c->is_null())
       job.crossing_pairs = c->get<std::size_t>();
+    if (const auto l = j.find("layered"); l != j.end() && l->is_boolean()) job.layered = l->get<bool>();
     // Absent in documents written before the field existed.
     if (const auto t = j.find("triangles"); t != j.end() && !t->is_null()) job.triangles = t->get<TriangleQuality>();
     if (const auto t = j.find("seconds_by_step"); t != j.end() && !t->is_null())

@@ -53,6 +53,8 @@ struct JobRecord {
   /// Of the result: its pairs of faces that cross each other (Result::crossing_pairs); nullopt
   /// until the job succeeded.
   std::optional<std::size_t> crossing_pairs;
+  /// Of the result: it lies over itself throughout, its crossing pairs not counted (Result::layered).
+  bool layered = false;
   /// Of the result: its triangles' shapes (Result::triangles); nullopt until the job succeeded.
   std::optional<TriangleQuality> triangles;
   /// Of the run that succeeded: where its time went, step by step (Result::phases), and the

@@ -309,6 +309,7 @@ void JobManager::run(const std::string& id) {
       job->record.outcome = std::string(remesh::api::outcome_name(result.outcome));
       job->record.thin_parts = result.thin;
       job->record.crossing_pairs = result.crossing_pairs;
+      job->record.layered = result.layered;
       job->record.triangles = result.triangles;
       job->record.dual = out.dual;
       job->record.seconds_by_step = remesh::api::JobRecord::StepSeconds{result.phases, result.seconds};

@@ -111,8 +111,12 @@ struct Result {
   ThinParts thin;
   /// The returned mesh's pairs of faces that cross each other (find_self_intersections: faces
   /// sharing an edge never count, touching ones neither), after the untangling; left where the
-  /// input crosses itself or parts are thinner than the edges. Unknown for a cancelled run.
+  /// input crosses itself or parts are thinner than the edges. Unknown for a cancelled run, and for
+  /// a layered one.
   std::optional<std::size_t> crossing_pairs;
+  /// The returned mesh lies over itself throughout (lies_over_itself: a part duplicated in place,
+  /// shells stacked on each other): its crossing pairs were neither counted nor moved apart.
+  bool layered = false;
   /// The returned mesh's triangle shapes (triangle_quality.h). Unknown for a cancelled run.
   std::optional<TriangleQuality> triangles;
 };

@@ -1,8 +1,10 @@
 #include "remesh/feature_snap.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
+#include <numeric>
 #include <vector>
 
 #include "core/parallel.h"
@@ -42,13 +44,36 @@ const double kCreaseCos = std::cos(20.0 * std::acos(-1.0) / 180.0);
 
 constexpr double kMaxCreaseParts = 1 << 16;
 
-/// The interior reference vertices and, with a spacing, points along the creases (see the header).
+/// `points` without the repeats of a position, in the order of their first occurrence. A reference
+/// with parts laid over each other (a part duplicated in place) repeats its vertices: the snap moved
+/// a mesh vertex onto each copy in turn, and judged every move against every copy near it (one
+/// icosahedron 2 048 times at one place: 18 of a run's 50 s). The repeats change no judgement.
+std::vector<Vec3> without_repeats(std::vector<Vec3> points) {
+  std::vector<std::uint32_t> order(points.size());
+  std::iota(order.begin(), order.end(), 0u);
+  auto key = [&](std::uint32_t i) { return std::array<double, 3>{points[i][0], points[i][1], points[i][2]}; };
+  std::sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) {
+    const auto ka = key(a), kb = key(b);
+    return ka < kb || (ka == kb && a < b);
+  });
+  std::vector<char> repeat(points.size(), 0);
+  for (std::size_t k = 1; k < order.size(); ++k)
+    if (key(order[k]) == key(order[k - 1])) repeat[order[k]] = 1;
+  std::size_t kept = 0;
+  for (std::size_t i = 0; i < points.size(); ++i)
+    if (!repeat[i]) points[kept++] = points[i];
+  points.resize(kept);
+  return points;
+}
+
+/// The interior reference vertices and, with a spacing, points along the creases (see the header),
+/// each position once.
 std::vector<Vec3> feature_points(const TriMesh& reference, double crease_spacing) {
   std::vector<Vec3> points;
   for (auto v : reference.vertices())
     if (!reference.status(v).deleted() && !reference.is_isolated(v) && !reference.is_boundary(v))
       points.push_back(reference.point(v));
-  if (!(crease_spacing > 0)) return points;
+  if (!(crease_spacing > 0)) return without_repeats(std::move(points));
   const std::vector<Vec3> normals = geom::face_normals(reference, 1);  // each face's once, not per edge
   for (auto e : reference.edges()) {
     if (reference.status(e).deleted() || reference.is_boundary(e)) continue;
@@ -65,7 +90,7 @@ std::vector<Vec3> feature_points(const TriMesh& reference, double crease_spacing
     const double parts = std::min(std::ceil(length / crease_spacing), kMaxCreaseParts);
     for (double k = 1; k < parts; ++k) points.push_back(a + (k / parts) * (b - a));
   }
-  return points;
+  return without_repeats(std::move(points));
 }
 
 /// A point's distance to the mesh comes from the triangles around its 30 nearest mesh vertices

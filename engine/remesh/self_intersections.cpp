@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cmath>
 #include <cstdint>
 #include <vector>
@@ -176,7 +177,9 @@ namespace {
 
 /// The broad phase of find_self_intersections: calls test(i, j, block) once for every pair of
 /// `faces` whose bounding spheres overlap (and for a few more), from parallel blocks numbered
-/// 0 .. out.size() - 1 (out is resized to hold one result vector per block).
+/// 0 .. out.size() - 1 (out is resized to hold one result vector per block). Once `halt` (when
+/// given) is set, the blocks stop at their next face (a cell of faces stacked in place can hold
+/// thousands).
 /// A uniform grid with cells of side h, twice the 99th percentile of the radii: two faces whose
 /// radii are at most h / 2 and whose spheres overlap have their centres within h of each other in
 /// every coordinate, so in the same cell or in adjacent ones, and each pair of adjacent cells is
@@ -184,7 +187,8 @@ namespace {
 /// reach and against each other.
 template <typename Test, typename Out>
 void for_overlapping_spheres(const FaceSpheres& spheres, const std::vector<unsigned>& faces, unsigned threads,
-                             Test&& test, std::vector<Out>& out) {
+                             Test&& test, std::vector<Out>& out, const std::atomic<bool>* halt = nullptr) {
+  auto halted = [&] { return halt && halt->load(std::memory_order_relaxed); };
   const std::size_t n = faces.size();
   auto overlap = [&](unsigned i, unsigned j) {
     return spheres_overlap({spheres.centres[i], spheres.radii[i]}, {spheres.centres[j], spheres.radii[j]});
@@ -243,10 +247,10 @@ void for_overlapping_spheres(const FaceSpheres& spheres, const std::vector<unsig
   out.assign(cell_blocks + big.size(), Out());
   // Small faces: each cell with itself and its 13 neighbours that come after it.
   parallel_blocks(keys.size(), kBlock, threads, [&](std::size_t b, std::size_t e, std::size_t block) {
-    for (std::size_t c = b; c < e; ++c) {
+    for (std::size_t c = b; c < e && !halted(); ++c) {
       const std::uint64_t key = keys[c];
       const auto [x, y, z] = cell_of(key);
-      for (std::size_t u = begins[c]; u < begins[c + 1]; ++u)
+      for (std::size_t u = begins[c]; u < begins[c + 1] && !halted(); ++u)
         for (std::size_t v = u + 1; v < begins[c + 1]; ++v)
           if (overlap(entries[u].second, entries[v].second)) test(entries[u].second, entries[v].second, block);
       for (int dx = 0; dx <= 1; ++dx)
@@ -255,7 +259,7 @@ void for_overlapping_spheres(const FaceSpheres& spheres, const std::vector<unsig
             if (x + dx < 0 || y + dy < 0 || z + dz < 0 || y + dy >= (1 << 21) || z + dz >= (1 << 21)) continue;
             const std::ptrdiff_t d = cell(key_of(x + dx, y + dy, z + dz));
             if (d < 0) continue;
-            for (std::size_t u = begins[c]; u < begins[c + 1]; ++u)
+            for (std::size_t u = begins[c]; u < begins[c + 1] && !halted(); ++u)
               for (std::size_t v = begins[d]; v < begins[d + 1]; ++v)
                 if (overlap(entries[u].second, entries[v].second)) test(entries[u].second, entries[v].second, block);
           }
@@ -264,7 +268,7 @@ void for_overlapping_spheres(const FaceSpheres& spheres, const std::vector<unsig
   // Big faces: against the small faces of the cells within their reach, and against the big faces
   // after them.
   parallel_blocks(big.size(), 1, threads, [&](std::size_t b, std::size_t e, std::size_t) {
-    for (std::size_t k = b; k < e; ++k) {
+    for (std::size_t k = b; k < e && !halted(); ++k) {
       const unsigned f = big[k];
       const std::size_t block = cell_blocks + k;
       const Vec3& c = spheres.centres[f];
@@ -334,6 +338,31 @@ std::vector<std::pair<unsigned, unsigned>> find_self_intersections(const TriMesh
   for (auto& b : found) pairs.insert(pairs.end(), b.begin(), b.end());
   std::sort(pairs.begin(), pairs.end());
   return pairs;
+}
+
+bool lies_over_itself(const TriMesh& mesh, unsigned threads) {
+  const FaceSpheres spheres = face_spheres(mesh);
+  std::vector<unsigned> faces;
+  faces.reserve(mesh.n_faces());
+  for (std::size_t i = 0; i < mesh.n_faces(); ++i)
+    if (!mesh.has_face_status() || !mesh.status(OpenMesh::FaceHandle(static_cast<int>(i))).deleted())
+      faces.push_back(static_cast<unsigned>(i));
+  const std::size_t limit = kLayeredOverlapsPerFace * faces.size();
+  // Each block counts its pairs and adds them to the shared count every kShare, when the blocks
+  // stop once it is over the limit. The count is over the limit only when more than `limit` pairs
+  // overlap, and exact when the blocks ran to their end: the answer does not depend on the
+  // threads' timing.
+  constexpr std::size_t kShare = 4096;
+  std::atomic<std::size_t> shared{0};
+  std::atomic<bool> over{false};
+  std::vector<std::size_t> counts;
+  for_overlapping_spheres(spheres, faces, threads, [&](unsigned, unsigned, std::size_t block) {
+    if (++counts[block] % kShare == 0 && shared.fetch_add(kShare, std::memory_order_relaxed) + kShare > limit)
+      over.store(true, std::memory_order_relaxed);
+  }, counts, &over);
+  std::size_t total = 0;
+  for (std::size_t c : counts) total += c;
+  return over.load() || total > limit;
 }
 
 }  // namespace remesh

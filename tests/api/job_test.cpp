@@ -54,6 +54,7 @@ TEST_CASE("job document: fields, links only when succeeded, round trip", "[api][
   CHECK(doc["outcome"].is_null());
   CHECK(doc["thin_parts"].is_null());
   CHECK(doc["crossing_pairs"].is_null());
+  CHECK(doc["layered"] == false);
   CHECK(doc["triangles"].is_null());
   CHECK(doc["seconds_by_step"].is_null());
   CHECK(doc["dual"].is_null());
@@ -82,6 +83,7 @@ TEST_CASE("job document: fields, links only when succeeded, round trip", "[api][
   r.thin_parts->vertices_thicker = 900, r.thin_parts->regular_thicker = 811;
   r.thin_parts->sampled = true;
   r.crossing_pairs = 36;
+  r.layered = true;
   r.triangles = TriangleQuality{1000, 31.5, 112.25, 0.0, 0.0125, 0.625, 0.9875};
   PhaseSeconds phases;
   phases.stellar = 0.5, phases.projection = 0.25, phases.untangle = 0.125;
@@ -115,6 +117,7 @@ TEST_CASE("job document: fields, links only when succeeded, round trip", "[api][
         json{{"limit", 3.5}, {"thinner", {{"vertices", 40}, {"regular", 31}}},
              {"thicker", {{"vertices", 900}, {"regular", 811}}}, {"sampled", true}});
   CHECK(doc["crossing_pairs"] == 36);
+  CHECK(doc["layered"] == true);
   CHECK(doc["triangles"] == json{{"faces", 1000}, {"min_angle", 31.5}, {"max_angle", 112.25}, {"below_30", 0.0},
                                  {"above_90", 0.0125}, {"min_radius_ratio", 0.625}, {"mean_radius_ratio", 0.9875}});
   CHECK(doc["timings"]["queued_seconds"] == Approx(1.0));
@@ -146,6 +149,7 @@ TEST_CASE("job document: fields, links only when succeeded, round trip", "[api][
   CHECK(back.thin_parts->regular_thicker == 811);
   CHECK(back.thin_parts->sampled);
   CHECK(back.crossing_pairs == std::optional<std::size_t>(36));
+  CHECK(back.layered);
   REQUIRE(back.triangles);
   CHECK(back.triangles->faces == 1000);
   CHECK(back.triangles->max_angle == 112.25);
@@ -155,8 +159,10 @@ TEST_CASE("job document: fields, links only when succeeded, round trip", "[api][
     // A record written before the fields existed reads without them.
     json old = doc;
     old.erase("crossing_pairs");
+    old.erase("layered");
     old.erase("triangles");
     CHECK_FALSE(job_from_json(old).crossing_pairs);
+    CHECK_FALSE(job_from_json(old).layered);
     CHECK_FALSE(job_from_json(old).triangles);
   }
   {

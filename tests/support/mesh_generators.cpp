@@ -253,6 +253,20 @@ TriMesh make_plate_with_holes(int holes, double cell, int sub) {
 
 TriMesh make_double_torus(double cell, int sub) { return make_plate_with_holes(2, cell, sub); }
 
+TriMesh stacked_copies(const TriMesh& mesh, int copies, const Vec3& offset) {
+  TriMesh out;
+  for (int c = 0; c < copies; ++c) {
+    std::vector<OpenMesh::VertexHandle> added;
+    for (auto v : mesh.vertices()) added.push_back(out.add_vertex(mesh.point(v) + double(c) * offset));
+    for (auto f : mesh.faces()) {
+      std::vector<OpenMesh::VertexHandle> corners;
+      for (auto v : mesh.fv_range(f)) corners.push_back(added[v.idx()]);
+      out.add_face(corners);
+    }
+  }
+  return out;
+}
+
 std::string check_mesh_valid(const TriMesh& mesh, double area_eps, double fold_cos) {
   double total_area = 0;
   std::size_t faces = 0;

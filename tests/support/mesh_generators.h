@@ -36,6 +36,9 @@ TriMesh make_sliver_cylinder(int segments, double radius, double height);
 /// The same side (without its axis vertices), its caps fans from the rim vertex at angle 0 (as
 /// CAD exports write them): the caps' chords join two points of a rim.
 TriMesh make_rim_fanned_cylinder(int segments, double radius, double height);
+/// `copies` copies of `mesh` as components of one mesh, copy k moved by k * offset (offset zero:
+/// all at one place, as a file instancing a part several times at one spot gives).
+TriMesh stacked_copies(const TriMesh& mesh, int copies, const Vec3& offset = Vec3(0, 0, 0));
 
 /// Empty if `mesh` is valid: no deleted elements left, every vertex manifold, every face a
 /// non-degenerate triangle (area > area_eps * mean area), no folded pair of adjacent triangles

@@ -290,11 +290,36 @@ TEST_CASE("the result counts the faces that cross each other, as a recount of th
     test::scale_mean_edge(*mesh, 2.25);
     const Result r = equalize(*mesh, table_4_2(60));
     REQUIRE(r.crossing_pairs);
+    CHECK_FALSE(r.layered);
     CHECK(*r.crossing_pairs == find_self_intersections(*mesh, 1).size());
     counted[k++] = *r.crossing_pairs;
   }
   CHECK(counted[0] > 0);
   CHECK(counted[1] == 0);
+}
+
+TEST_CASE("a part duplicated in place is remeshed but not untangled, and said to be layered", "[equalize]") {
+  // Sixteen copies of one sphere at one place (as a file instancing a part sixteen times at one
+  // spot gives): every face lies over fifteen others. Moving faces apart cannot separate them, and
+  // counting their crossings took longer than the remeshing: the run does neither and says why.
+  const TriMesh copies = test::stacked_copies(test::make_icosphere(2), 16);
+  REQUIRE(test::check_mesh_valid(copies) == "");
+  TriMesh scaled = copies;
+  test::scale_mean_edge(scaled, 2.25);
+  for (bool cleanup : {true, false}) {
+    INFO("cleanup " << cleanup);
+    TriMesh mesh = scaled;
+    Params p = table_4_2(30);
+    p.cleanup = cleanup;  // without it (no untangling), the run still says so at its end
+    const Result r = equalize(mesh, p);
+    CHECK(test::check_mesh_valid(mesh) == "");
+    CHECK(test::count_components(mesh) == 16);
+    CHECK(test::plain_inside_fraction(mesh, 1.2, 1.8) > (cleanup ? 0.99 : 0.9));
+    CHECK(r.layered);
+    CHECK_FALSE(r.crossing_pairs);
+    CHECK(lies_over_itself(mesh, 1));
+    CHECK(find_self_intersections(mesh, 2).size() > mesh.n_faces());
+  }
 }
 
 TEST_CASE("convergence stops early unless all iterations are asked for", "[equalize]") {

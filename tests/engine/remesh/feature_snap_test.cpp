@@ -300,3 +300,15 @@ TEST_CASE("feature snap puts a mesh that cuts under a crease back onto it", "[st
     if (mesh.point(v) != before.point(v))
       CHECK((surface.closest_point(mesh.point(v)) - mesh.point(v)).norm() < 1e-9);
 }
+
+TEST_CASE("the snap's points are each position once, however often the reference repeats it", "[steps]") {
+  // A part laid over itself (a file instancing it at one place) repeats every vertex and crease:
+  // the points are those of one copy. Copies apart keep theirs.
+  const TriMesh box = test::make_box(2);
+  const FeatureSnap one(box, 0.4);
+  REQUIRE(one.size() > 8);
+  CHECK(FeatureSnap(test::stacked_copies(box, 5), 0.4).size() == one.size());
+  CHECK(FeatureSnap(test::stacked_copies(box, 5, Vec3(10, 0, 0)), 0.4).size() == 5 * one.size());
+  const TriMesh sphere = test::make_icosphere(2);
+  CHECK(FeatureSnap(test::stacked_copies(sphere, 3)).size() == sphere.n_vertices());
+}

@@ -235,6 +235,29 @@ TEST_CASE("find_self_intersections finds the pairs a brute-force test finds", "[
   }
 }
 
+TEST_CASE("lies_over_itself tells a surface stacked on itself from crossing and clean ones", "[untangle]") {
+  std::mt19937 rng(5);
+  TriMesh crumpled = test::make_icosphere(3, 10.0);
+  jitter(crumpled, 1.5, rng);
+  REQUIRE(find_self_intersections(crumpled, 1).size() > 100);
+  TriMesh torus = test::make_torus(40, 12, 3.0, 1.0);
+  jitter(torus, 0.25, rng);
+  for (unsigned threads : {1u, 2u}) {
+    INFO(threads << " threads");
+    // Faces through each other here and there, however many: not layered.
+    CHECK_FALSE(lies_over_itself(test::make_icosphere(3, 10.0), threads));
+    CHECK_FALSE(lies_over_itself(crumpled, threads));
+    CHECK_FALSE(lies_over_itself(torus, threads));
+    // A sphere four times at one place: each face over three others, about 4 x 7 overlapping
+    // spheres a face, under the limit of 64. Sixteen times: over it.
+    CHECK_FALSE(lies_over_itself(test::stacked_copies(test::make_icosphere(3, 10.0), 4), threads));
+    CHECK(lies_over_itself(test::stacked_copies(test::make_icosphere(3, 10.0), 16), threads));
+    // Sixteen copies side by side, apart: not layered.
+    TriMesh apart = test::stacked_copies(test::make_icosphere(3, 10.0), 16, Vec3(25, 0, 0));
+    CHECK_FALSE(lies_over_itself(apart, threads));
+  }
+}
+
 TEST_CASE("find_self_intersections passes over deleted faces", "[untangle]") {
   // The untangling's collapses leave deleted faces until its end (untangle.cpp): the search must
   // neither report them nor miss a pair of live faces, with or without a region; the same pairs,

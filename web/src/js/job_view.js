@@ -265,7 +265,10 @@ export class JobView {
       text += ` · ${share(by.thicker)} % regular where the input is at least ${by.limit.toPrecision(3)} thick, ` +
         `${share(by.thinner)} % in thinner parts`;
     }
-    if (job.crossing_pairs > 0) text += ` · ${job.crossing_pairs} pairs of faces crossing each other`;
+    if (job.layered)
+      text += ' · the surface lies over itself throughout, as a part duplicated in place does: ' +
+        'crossing faces not counted';
+    else if (job.crossing_pairs > 0) text += ` · ${job.crossing_pairs} pairs of faces crossing each other`;
     const tri = job.triangles;
     if (tri && tri.faces > 0)
       text += ` · angles ${tri.min_angle.toFixed(1)}° to ${tri.max_angle.toFixed(1)}°, ` +
