@@ -74,6 +74,14 @@ void JobManager::start() {
   std::sort(loaded.begin(), loaded.end(),
             [](const auto& a, const auto& b) { return a.record.created_at < b.record.created_at; });
   std::size_t requeued = 0;
+  // A run the process did not live through ended after its last row, not when the process started
+  // again: its finish is the time its rows were last written (at least its start), so that
+  // run_seconds does not count the time the service was down.
+  auto ended_at = [this](const JobRecord& r) {
+    double at = now_seconds();
+    if (r.started_at) at = std::max(*r.started_at, store_.stats_written_at(r.id).value_or(*r.started_at));
+    return at;
+  };
   {
     std::lock_guard lock(mutex_);
     for (JobStore::Loaded& l : loaded) {
@@ -83,7 +91,7 @@ void JobManager::start() {
       if (r.state == JobState::Cancelling) {  // the user asked; the process ended first
         r.state = JobState::Cancelled;
         r.outcome = "cancelled";
-        r.finished_at = now_seconds();
+        r.finished_at = ended_at(r);
         persist(r);
       }
       if (remesh::api::is_final(r.state)) {
@@ -94,7 +102,9 @@ void JobManager::start() {
           job->events.push_back({JobEvent::Kind::Iteration, r.state, i});
         job->events.push_back({JobEvent::Kind::State, r.state, 0});
       } else {
-        // Accepted but not finished: the rows of the run it did not finish go either way.
+        // Accepted but not finished: the rows of the run it did not finish go either way (when
+        // they were written is kept first, for a job failed below).
+        const double run_ended = ended_at(r);
         try {
           store_.clear_stats(r.id);
         } catch (const std::exception& e) {
@@ -109,7 +119,7 @@ void JobManager::start() {
           r.state = JobState::Failed;
           r.error = "the service stopped " + std::to_string(r.attempts) +
                     " times while running this job (a crash or a kill); it is not run again";
-          r.finished_at = now_seconds();
+          r.finished_at = run_ended;
           metrics_.count_job_finished(std::string(state_name(JobState::Failed)));
           log_.warn("job", {str("job", r.id), str("to", "failed"), str("error", *r.error)});
           job->events.push_back({JobEvent::Kind::State, JobState::Failed, 0});

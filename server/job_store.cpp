@@ -2,6 +2,7 @@
 
 #include <fcntl.h>
 #include <sys/file.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -153,6 +154,12 @@ void JobStore::append_stats(const std::string& id, const remesh::IterationStats&
 }
 
 void JobStore::clear_stats(const std::string& id) { write_file_atomic(dir(id) / "stats.jsonl", ""); }
+
+std::optional<double> JobStore::stats_written_at(const std::string& id) const {
+  struct stat st {};
+  if (::stat((dir(id) / "stats.jsonl").c_str(), &st) != 0) return std::nullopt;
+  return static_cast<double>(st.st_mtim.tv_sec) + 1e-9 * static_cast<double>(st.st_mtim.tv_nsec);
+}
 
 std::vector<remesh::IterationStats> JobStore::load_stats(const std::string& id) const {
   std::vector<remesh::IterationStats> rows;

@@ -46,6 +46,9 @@ class JobStore {
   void append_stats(const std::string& id, const remesh::IterationStats& row);
   /// Empties stats.jsonl (a job that runs again starts over).
   void clear_stats(const std::string& id);
+  /// When stats.jsonl was last written (seconds since the epoch, as api::now_seconds()): the last
+  /// row of a run the process did not live through. Nullopt if it cannot be read.
+  std::optional<double> stats_written_at(const std::string& id) const;
   /// Every complete row of stats.jsonl (a torn last line is skipped).
   std::vector<remesh::IterationStats> load_stats(const std::string& id) const;
   /// The uploaded bytes.

@@ -5,6 +5,7 @@
 #include <signal.h>
 
 #include <fstream>
+#include <chrono>
 #include <thread>
 
 #include "daemon.h"
@@ -289,7 +290,12 @@ TEST_CASE("remeshd: a job whose runs the process does not live through twice fai
     CHECK(wait_job(c, beside, running_with_rows)["attempts"] == 1);
     CHECK(d.stop(SIGKILL) == 128 + SIGKILL);
   }
+  auto seconds_now = [] {
+    return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
+  };
+  double started = 0, killed = 0;  // before the second daemon started, after it was killed
   {
+    started = seconds_now();
     Daemon d(data, {"--workers", "2"});
     auto c = d.client();
     // Both are suspects now: the first runs alone, nothing starts beside it.
@@ -298,13 +304,17 @@ TEST_CASE("remeshd: a job whose runs the process does not live through twice fai
     CHECK(get_job(c, beside)["state"] == "queued");
     CHECK(get_job(c, queued)["state"] == "queued");
     CHECK(d.stop(SIGKILL) == 128 + SIGKILL);
+    killed = seconds_now();
   }
+  // The service stays down a while: the failed run's time does not count it.
+  std::this_thread::sleep_for(std::chrono::seconds(2));
   Daemon d(data, {"--workers", "2"});
   auto c = d.client();
   const json failed = get_job(c, poison);
   CHECK(failed["state"] == "failed");
   CHECK(failed["attempts"] == 2);
   CHECK(failed["error"].get<std::string>().find("stopped 2 times") != std::string::npos);
+  CHECK(failed["timings"]["run_seconds"].get<double>() <= killed - started + 0.01);
   const json survived = wait_final(c, beside, 90);
   CHECK(survived["state"] == "succeeded");
   CHECK(survived["attempts"] == 2);  // its killed run, then its run alone
