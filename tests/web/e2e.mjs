@@ -364,7 +364,66 @@ async function main() {
   check(await page.textContent('#file-error') === '' && await page.textContent('#form-error') === '',
     'choosing another file clears the last file\'s message');
 
+  // --- a phone (390x844): the finished job and then a chosen file, in a context of its own ---
+  await check_phone(base, job_id, mesh_path, console_errors);
+
   check(console_errors.length === 0, `no errors in the browser console${console_errors.length ? `: ${console_errors.join(' | ')}` : ''}`);
+}
+
+/// At a phone's 390x844 viewport (touch, the page's `width=device-width`): the page never scrolls
+/// sideways (wide tables scroll in their own box), the 3D view and the charts fit the width, with a
+/// file chosen the file chooser, e_min/e_max and the Remesh button are in the first screen (the
+/// options folded) and Remesh is at least 40 px high, a finger's size.
+async function check_phone(base, job_id, mesh_path, console_errors) {
+  const W = 390, H = 844;
+  const context = await browser.newContext({ viewport: { width: W, height: H }, isMobile: true, hasTouch: true });
+  const phone = await context.newPage();
+  phone.on('console', (m) => { if (m.type() === 'error' && !/Failed to load resource/.test(m.text())) console_errors.push(`phone: ${m.text()}`); });
+  phone.on('pageerror', (e) => console_errors.push(`phone: ${e}`));
+  const measure = () => phone.evaluate(() => {
+    const box = (sel) => {
+      const r = document.querySelector(sel).getBoundingClientRect();
+      return { left: Math.round(r.left), right: Math.round(r.right), top: Math.round(r.top + scrollY),
+        bottom: Math.round(r.bottom + scrollY), width: Math.round(r.width), height: Math.round(r.height) };
+    };
+    // What sticks out on the right (none should), for the message.
+    const out = [...document.querySelectorAll('body *')].filter((e) => !e.closest('.tablewrap') &&
+      e.getBoundingClientRect().right > innerWidth + 0.5).map((e) => `${e.localName}${e.id ? `#${e.id}` : ''}`).slice(0, 5);
+    return { inner: innerWidth, scroll: document.documentElement.scrollWidth, out,
+      file: box('.filebtn'), emin: box('#emin'), emax: box('#emax'), submit: box('#submit'),
+      more_open: document.getElementById('more-options').open,
+      canvases: ['#view3d', '#histogram', '#chart-length', '#chart-seconds'].map(box) };
+  });
+  const sideways = (m) => `scrollWidth ${m.scroll}, innerWidth ${m.inner}${m.out.length ? `; sticking out: ${m.out.join(' ')}` : ''}`;
+  try {
+    // A first visit: choose a file, and the form is ready to send. The name takes two lines at
+    // this width, as a scan's or a CAD export's often does.
+    const named = path.join(tmp, 'statue_scan_2026-11-27_decimated_final_v2.obj');
+    fs.copyFileSync(mesh_path, named);
+    await phone.goto(base, { waitUntil: 'load' });
+    await phone.waitForFunction(() => window.__remeshd, null, { timeout: 60000 });
+    await phone.setInputFiles('#file', named);
+    await phone.waitForFunction(() => +document.getElementById('input-mean').dataset.value > 0, null, { timeout: 10000 });
+    const form = await measure();
+    await phone.screenshot({ path: path.join(artifacts, '5-phone-file.png') });
+    check(form.scroll <= form.inner, `phone ${W}x${H}, a file chosen: the page does not scroll sideways (${sideways(form)})`);
+    check(!form.more_open && Math.max(form.file.bottom, form.emin.bottom, form.emax.bottom, form.submit.bottom) <= H,
+      `phone, a file chosen: the file chooser, e_min/e_max and Remesh in the first ${H} px with the options folded ` +
+      `(bottoms ${form.file.bottom}, ${form.emin.bottom}, ${form.emax.bottom}, Remesh ${form.submit.bottom})`);
+    check(form.submit.height >= 40, `phone: Remesh is a touch target at least 40 px high (${form.submit.height} px)`);
+
+    // The finished job: downloads, 3D view, histogram, charts and its table.
+    await phone.evaluate((id) => { location.hash = `job=${id}`; }, job_id);
+    await phone.waitForFunction(() => document.querySelector('#rows tbody tr') && document.querySelector('#downloads button') &&
+      /^remeshed/.test(document.getElementById('view-status').textContent), null, { timeout: 20000 }).catch(() => {});
+    const job = await measure();
+    await phone.screenshot({ path: path.join(artifacts, '6-phone-job.png'), fullPage: true });
+    check(job.scroll <= job.inner, `phone, a finished job: the page does not scroll sideways (${sideways(job)})`);
+    check(job.canvases.every((c) => c.left >= 0 && c.right <= job.inner && c.width >= 0.8 * job.inner),
+      `phone: the 3D view, histogram and charts fit the width (${job.canvases.map((c) => `${c.left}..${c.right}`).join(', ')})`);
+  } finally {
+    await context.close();
+  }
 }
 
 /// Checks the histogram of the mesh shown (`name`): its short/long bars hold exactly the edges the
