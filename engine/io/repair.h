@@ -39,8 +39,8 @@ struct DroppedFaces {
 };
 
 /// Appends triangles covering the simple polygon idx[0..n) (n >= 3): ear clipping in the plane of
-/// the polygon's Newell normal, falling back to a fan when the polygon is degenerate, self-
-/// intersecting or has more than 256 corners. Indices must be valid.
+/// the polygon's Newell normal, falling back to a fan when the polygon is degenerate or
+/// self-intersecting (or, past 256 corners, after 5e7 point-in-ear tests). Indices must be valid.
 void triangulate_polygon(const std::vector<Vec3>& points, const std::int64_t* idx, std::size_t n,
                          std::vector<Tri>& out);
 

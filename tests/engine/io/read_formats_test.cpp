@@ -109,6 +109,57 @@ TEST_CASE("OBJ: a concave polygon is ear-clipped, not fanned across the outside"
   for (auto f : m.mesh.faces()) CHECK(m.mesh.normal(f)[2] > 0.99);
 }
 
+TEST_CASE("OBJ: polygons of thousands of corners are ear-clipped too, star-shaped or with a notch") {
+  // Flat polygons in z = 0, counter-clockwise: a star whose radii alternate (every other corner
+  // reflex; a fan from the first corner crosses the outside), and a disk with a deep notch cut into
+  // it. Their triangles must cover the polygon once: n - 2 of them, all facing up, their areas adding
+  // up to the polygon's.
+  const double pi = std::acos(-1.0);
+  auto polygon = [&](std::size_t n, auto radius_at) {
+    std::vector<std::array<double, 2>> p(n);
+    for (std::size_t i = 0; i < n; ++i) {
+      const double t = 2 * pi * double(i) / double(n), r = radius_at(i, t);
+      p[i] = {r * std::cos(t), r * std::sin(t)};
+    }
+    return p;
+  };
+  const std::pair<const char*, std::vector<std::array<double, 2>>> cases[] = {
+      {"star 2400", polygon(2400, [](std::size_t i, double) { return i % 2 ? 0.8 : 1.0; })},
+      {"star 301", polygon(301, [](std::size_t i, double) { return i % 2 ? 0.5 : 1.0; })},
+      {"notched disk 5000", polygon(5000, [&](std::size_t, double t) { return std::abs(t - pi) < 0.3 ? 0.05 : 1.0; })},
+  };
+  for (const auto& [what, p] : cases) {
+    CAPTURE(what);
+    std::string obj;
+    double area = 0;  // shoelace
+    for (std::size_t i = 0; i < p.size(); ++i) {
+      obj += "v ";
+      obj += std::to_string(p[i][0]);
+      obj += ' ';
+      obj += std::to_string(p[i][1]);
+      obj += " 0\n";
+      const auto& q = p[(i + 1) % p.size()];
+      area += 0.5 * (p[i][0] * q[1] - q[0] * p[i][1]);
+    }
+    obj += "f";
+    for (std::size_t i = 1; i <= p.size(); ++i) {
+      obj += ' ';
+      obj += std::to_string(i);
+    }
+    obj += "\n";
+    const LoadedMesh m = read_as(obj);
+    CHECK(m.mesh.n_faces() == p.size() - 2);
+    double sum = 0;
+    std::size_t down = 0;
+    for (auto f : m.mesh.faces()) {
+      sum += m.mesh.calc_face_area(f);
+      if (!(m.mesh.normal(f)[2] > 0.99)) ++down;
+    }
+    CHECK(down == 0);
+    CHECK(sum == Approx(area).epsilon(1e-4));
+  }
+}
+
 TEST_CASE("OFF: ASCII with comments, colours and counts on the header line, binary OFF") {
   const std::string off =
       "COFF 4 4 6 # tetrahedron\n"
