@@ -117,6 +117,40 @@ TEST_CASE("Garbled OFF with its records wrapped over lines gives an error or a v
   CHECK(outcome.meshes > 1);
 }
 
+TEST_CASE("Garbled OBJ with star-shaped caps of 300 sides gives an error or a valid mesh") {
+  // A prism whose caps are star-shaped 300-gons: polygons past 256 sides take the large ear
+  // clipping (triangulate.cpp), here under ASan too, with corners moved and indices broken.
+  const double pi = std::acos(-1.0);
+  constexpr int n = 300;
+  std::string obj;
+  char line[96];
+  for (int z = 0; z < 2; ++z)
+    for (int i = 0; i < n; ++i) {
+      const double t = 2 * pi * i / n, r = i % 2 ? 0.7 : 1.0;
+      std::snprintf(line, sizeof line, "v %.6f %.6f %d\n", r * std::cos(t), r * std::sin(t), z);
+      obj += line;
+    }
+  obj += "f";
+  for (int i = n; i >= 1; --i) obj += ' ' + std::to_string(i);
+  obj += "\nf";
+  for (int i = 1; i <= n; ++i) obj += ' ' + std::to_string(n + i);
+  obj += '\n';
+  for (int i = 0; i < n; ++i) {
+    const int j = (i + 1) % n;
+    std::snprintf(line, sizeof line, "f %d %d %d %d\n", i + 1, j + 1, n + j + 1, n + i + 1);
+    obj += line;
+  }
+  LoadedMesh m;
+  REQUIRE_NOTHROW(m = read_mesh(obj));
+  CHECK(m.mesh.n_faces() == 2 * (n - 2) + 2 * n);
+  CHECK(test::euler_characteristic(m.mesh) == 2);
+  std::mt19937 rng(20261127);
+  Outcome outcome;
+  garble(obj, Format::Obj, "star prism obj", rng, outcome);
+  CHECK(outcome.errors > 0);
+  CHECK(outcome.meshes > 1);
+}
+
 TEST_CASE("Vertices snapped onto a neighbour or an edge give a valid mesh without zero-area faces") {
   // Needles (a vertex onto a neighbour, exactly or 1e-14 off) and caps (a vertex onto the segment
   // between two neighbours), several at random, some touching: the mesh read is valid with no
