@@ -317,13 +317,14 @@ Crossings untangle_and_mend(TriMesh& mesh, const ReferenceSurface& reference, co
                             PhaseSeconds& phases, std::stop_token stop) {
   // The row describes the mesh before the feature snap, which takes no edge out of the interval.
   const std::size_t outside_before = row.small + row.big;
+  // The crossing pairs of the mesh, for the next round's untangling (which would search for them
+  // again): first those the snap left, then those counted after a mend.
+  std::optional<std::vector<std::pair<unsigned, unsigned>>> crossing;
   {
     PhaseTimer timer(phases.untangle);
-    if (lies_over_itself(mesh, params.threads)) return {std::nullopt, true};
+    crossing = find_self_intersections_unless_layered(mesh, params.threads);
+    if (!crossing) return {std::nullopt, true};
   }
-  // The crossing pairs counted after a mend, for the next round's untangling (which would search
-  // for them again).
-  std::optional<std::vector<std::pair<unsigned, unsigned>>> crossing;
   for (int round = 1;; ++round) {
     PhaseTimer timer(phases.untangle);
     const UntangleCounts u = untangle_creases_first(mesh, reference, params.e_min, params.e_max, params.threads,
@@ -801,8 +802,9 @@ Result equalize(TriMesh& mesh, const Params& requested, const OnIteration& on_it
   // A run without the untangling (cleanup off, or stopped before it) counts them here; a cancelled
   // one leaves them unknown.
   if (!result.crossing_pairs && !result.layered && result.outcome != Outcome::Cancelled) {
-    result.layered = lies_over_itself(mesh, threads);
-    if (!result.layered) result.crossing_pairs = find_self_intersections(mesh, threads).size();
+    const auto crossing = find_self_intersections_unless_layered(mesh, threads);
+    result.layered = !crossing;
+    if (crossing) result.crossing_pairs = crossing->size();
   }
   if (result.outcome != Outcome::Cancelled) result.triangles = triangle_quality(mesh);
   result.seconds = seconds_since(start);

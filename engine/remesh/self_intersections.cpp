@@ -5,6 +5,7 @@
 #include <atomic>
 #include <cmath>
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include "core/parallel.h"
@@ -340,7 +341,23 @@ std::vector<std::pair<unsigned, unsigned>> find_self_intersections(const TriMesh
   return pairs;
 }
 
-bool lies_over_itself(const TriMesh& mesh, unsigned threads) {
+namespace {
+
+/// What one block of the broad phase found: its crossing pairs (when asked for) and how many pairs
+/// of overlapping spheres it met.
+struct BlockFinds {
+  std::vector<std::pair<unsigned, unsigned>> pairs;
+  std::size_t overlaps = 0;
+};
+
+/// The broad phase over every live face, counting the pairs of overlapping spheres and, with
+/// `cross`, collecting the pairs that cross (find_self_intersections); nullopt once more than
+/// kLayeredOverlapsPerFace pairs a face overlap. Each block adds its count to the shared one every
+/// kShare pairs, and the blocks stop once that is over the limit. Over the limit only when more
+/// than `limit` pairs overlap, and exact when the blocks ran to their end: the answer does not
+/// depend on the threads' timing.
+std::optional<std::vector<std::pair<unsigned, unsigned>>> unless_layered(const TriMesh& mesh, unsigned threads,
+                                                                        bool cross) {
   const FaceSpheres spheres = face_spheres(mesh);
   std::vector<unsigned> faces;
   faces.reserve(mesh.n_faces());
@@ -348,21 +365,33 @@ bool lies_over_itself(const TriMesh& mesh, unsigned threads) {
     if (!mesh.has_face_status() || !mesh.status(OpenMesh::FaceHandle(static_cast<int>(i))).deleted())
       faces.push_back(static_cast<unsigned>(i));
   const std::size_t limit = kLayeredOverlapsPerFace * faces.size();
-  // Each block counts its pairs and adds them to the shared count every kShare, when the blocks
-  // stop once it is over the limit. The count is over the limit only when more than `limit` pairs
-  // overlap, and exact when the blocks ran to their end: the answer does not depend on the
-  // threads' timing.
   constexpr std::size_t kShare = 4096;
   std::atomic<std::size_t> shared{0};
   std::atomic<bool> over{false};
-  std::vector<std::size_t> counts;
-  for_overlapping_spheres(spheres, faces, threads, [&](unsigned, unsigned, std::size_t block) {
-    if (++counts[block] % kShare == 0 && shared.fetch_add(kShare, std::memory_order_relaxed) + kShare > limit)
+  std::vector<BlockFinds> found;
+  for_overlapping_spheres(spheres, faces, threads, [&](unsigned i, unsigned j, std::size_t block) {
+    BlockFinds& b = found[block];
+    if (++b.overlaps % kShare == 0 && shared.fetch_add(kShare, std::memory_order_relaxed) + kShare > limit)
       over.store(true, std::memory_order_relaxed);
-  }, counts, &over);
+    if (cross && corners_cross(mesh, spheres.corners[i], spheres.corners[j]))
+      b.pairs.emplace_back(std::min(i, j), std::max(i, j));
+  }, found, &over);
   std::size_t total = 0;
-  for (std::size_t c : counts) total += c;
-  return over.load() || total > limit;
+  for (const BlockFinds& b : found) total += b.overlaps;
+  if (over.load() || total > limit) return std::nullopt;
+  std::vector<std::pair<unsigned, unsigned>> pairs;
+  for (BlockFinds& b : found) pairs.insert(pairs.end(), b.pairs.begin(), b.pairs.end());
+  std::sort(pairs.begin(), pairs.end());
+  return pairs;
+}
+
+}  // namespace
+
+bool lies_over_itself(const TriMesh& mesh, unsigned threads) { return !unless_layered(mesh, threads, false); }
+
+std::optional<std::vector<std::pair<unsigned, unsigned>>> find_self_intersections_unless_layered(const TriMesh& mesh,
+                                                                                                unsigned threads) {
+  return unless_layered(mesh, threads, true);
 }
 
 }  // namespace remesh

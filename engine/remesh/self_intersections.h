@@ -8,6 +8,7 @@
 
 #include <array>
 #include <cstddef>
+#include <optional>
 #include <utility>
 #include <vector>
 
@@ -78,5 +79,11 @@ constexpr std::size_t kLayeredOverlapsPerFace = 64;
 /// the limit: at most about kLayeredOverlapsPerFace sphere tests a face, no triangle tests. The
 /// answer does not depend on the thread count.
 bool lies_over_itself(const TriMesh& mesh, unsigned threads);
+
+/// find_self_intersections(mesh, threads), or nullopt for a mesh that lies over itself throughout
+/// (lies_over_itself), found in the same search: its answer costs one search, and a layered mesh
+/// no more than lies_over_itself.
+std::optional<std::vector<std::pair<unsigned, unsigned>>> find_self_intersections_unless_layered(const TriMesh& mesh,
+                                                                                                unsigned threads);
 
 }  // namespace remesh

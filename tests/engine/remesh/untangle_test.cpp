@@ -244,14 +244,21 @@ TEST_CASE("lies_over_itself tells a surface stacked on itself from crossing and 
   jitter(torus, 0.25, rng);
   for (unsigned threads : {1u, 2u}) {
     INFO(threads << " threads");
-    // Faces through each other here and there, however many: not layered.
+    // Faces through each other here and there, however many: not layered, and the search that
+    // tells finds every crossing pair.
     CHECK_FALSE(lies_over_itself(test::make_icosphere(3, 10.0), threads));
     CHECK_FALSE(lies_over_itself(crumpled, threads));
     CHECK_FALSE(lies_over_itself(torus, threads));
+    for (const TriMesh* m : {&crumpled, &torus}) {
+      const auto found = find_self_intersections_unless_layered(*m, threads);
+      REQUIRE(found);
+      CHECK(*found == brute_force_pairs(*m));
+    }
     // A sphere four times at one place: each face over three others, about 4 x 7 overlapping
     // spheres a face, under the limit of 64. Sixteen times: over it.
     CHECK_FALSE(lies_over_itself(test::stacked_copies(test::make_icosphere(3, 10.0), 4), threads));
     CHECK(lies_over_itself(test::stacked_copies(test::make_icosphere(3, 10.0), 16), threads));
+    CHECK_FALSE(find_self_intersections_unless_layered(test::stacked_copies(test::make_icosphere(3, 10.0), 16), threads));
     // Sixteen copies side by side, apart: not layered.
     TriMesh apart = test::stacked_copies(test::make_icosphere(3, 10.0), 16, Vec3(25, 0, 0));
     CHECK_FALSE(lies_over_itself(apart, threads));
