@@ -109,7 +109,7 @@ TEST_CASE("OBJ: a concave polygon is ear-clipped, not fanned across the outside"
   for (auto f : m.mesh.faces()) CHECK(m.mesh.normal(f)[2] > 0.99);
 }
 
-TEST_CASE("OBJ: polygons of thousands of corners are ear-clipped too, star-shaped or with a notch") {
+TEST_CASE("OBJ: polygons of thousands of corners are ear-clipped too, star-shaped, notched or concave") {
   // Flat polygons in z = 0, counter-clockwise: a star whose radii alternate (every other corner
   // reflex; a fan from the first corner crosses the outside), and a disk with a deep notch cut into
   // it. Their triangles must cover the polygon once: n - 2 of them, all facing up, their areas adding
@@ -123,10 +123,25 @@ TEST_CASE("OBJ: polygons of thousands of corners are ear-clipped too, star-shape
     }
     return p;
   };
+  // A triangle whose sides bow inward: every corner but its three tips reflex, so that each ear's
+  // test meets thousands of reflex corners unless it looks only near the ear.
+  auto concave_triangle = [&](std::size_t per_side) {
+    std::vector<std::array<double, 2>> p;
+    for (int k = 0; k < 3; ++k) {
+      const double ta = pi / 2 + 2 * pi * k / 3, tb = ta + 2 * pi / 3;
+      for (std::size_t i = 0; i < per_side; ++i) {
+        const double t = double(i) / double(per_side), bow = 1 - 0.2 * std::sin(pi * t);
+        const double x = (1 - t) * std::cos(ta) + t * std::cos(tb), y = (1 - t) * std::sin(ta) + t * std::sin(tb);
+        p.push_back({bow * x, bow * y});
+      }
+    }
+    return p;
+  };
   const std::pair<const char*, std::vector<std::array<double, 2>>> cases[] = {
       {"star 2400", polygon(2400, [](std::size_t i, double) { return i % 2 ? 0.8 : 1.0; })},
       {"star 301", polygon(301, [](std::size_t i, double) { return i % 2 ? 0.5 : 1.0; })},
       {"notched disk 5000", polygon(5000, [&](std::size_t, double t) { return std::abs(t - pi) < 0.3 ? 0.05 : 1.0; })},
+      {"concave triangle 30000", concave_triangle(10000)},
   };
   for (const auto& [what, p] : cases) {
     CAPTURE(what);
