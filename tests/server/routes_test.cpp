@@ -13,7 +13,9 @@
 
 #include "api/json_codec.h"
 #include "daemon.h"
+#include "io/mesh_io.h"
 #include "routes.h"
+#include "support/mesh_generators.h"
 
 using nlohmann::json;
 using namespace remesh::test;
@@ -94,6 +96,7 @@ TEST_CASE("remeshd: submit raw and multipart, follow, download, list, delete", "
   CHECK(done["thin_parts"]["in_thin_parts"] == 0);
   CHECK(done["thin_parts"]["limit"].get<double>() == Approx(0.4 / std::sqrt(3.0)));
   CHECK(done["crossing_pairs"] == 0);  // a ball's result does not cross itself
+  CHECK(done["layered"] == false);
   // The result's triangles: as many as a closed ball of its vertices and edges has (F = E - V + 2).
   const json& tri = done["triangles"];
   CHECK(tri["faces"] == done["latest"]["edges"].get<int>() - done["latest"]["vertices"].get<int>() + 2);
@@ -226,6 +229,22 @@ TEST_CASE("remeshd: submit raw and multipart, follow, download, list, delete", "
         std::string::npos);
   CHECK(metrics->body.find("remeshd_http_request_duration_seconds_bucket{route=\"/api/v1/jobs/{id}/result\"") !=
         std::string::npos);
+}
+
+TEST_CASE("remeshd: a job whose mesh lies over itself throughout is said to be layered, its crossings uncounted",
+          "[server]") {
+  // Sixteen copies of a ball at one place, as a file instancing a part at one spot gives.
+  TempDir tmp;
+  Daemon d(tmp.path / "data");
+  auto c = d.client();
+  const std::string mesh = remesh::write_mesh(remesh::test::stacked_copies(remesh::test::make_icosphere(2), 16), remesh::Format::Obj);
+  auto r = submit_raw(c, mesh, "emin=0.2&emax=0.35&filename=stack.obj");
+  REQUIRE(r);
+  REQUIRE(r->status == 202);
+  const json done = wait_final(c, body_of(r)["id"]);
+  REQUIRE(done["state"] == "succeeded");
+  CHECK(done["layered"] == true);
+  CHECK(done["crossing_pairs"].is_null());
 }
 
 TEST_CASE("remeshd: relax_dual relaxes the dual's bonds, and its downloads are that dual", "[server]") {
