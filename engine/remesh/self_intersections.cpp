@@ -344,8 +344,8 @@ std::vector<std::pair<unsigned, unsigned>> find_self_intersections(const TriMesh
 namespace {
 
 /// What one block of the broad phase found: its crossing pairs (when asked for) and how many pairs
-/// of overlapping spheres it met.
-struct BlockFinds {
+/// of overlapping spheres it met. A cache line each: two threads count into neighbouring blocks.
+struct alignas(64) BlockFinds {
   std::vector<std::pair<unsigned, unsigned>> pairs;
   std::size_t overlaps = 0;
 };
