@@ -1,14 +1,17 @@
 /// \file cmd_info.cpp
-/// `remesh info MESH [--json] [--weld]`: the summary of a mesh and every repair made reading it.
+/// `remesh info MESH [--json] [--weld]`: the summary of a mesh, its faces that cross each other,
+/// and every repair made reading it.
 
 #include <cstdio>
 #include <iostream>
+#include <optional>
 #include <sstream>
 
 #include "args.h"
 #include "commands.h"
 #include "io/summary.h"
 #include "api/json_codec.h"
+#include "remesh/self_intersections.h"
 
 namespace remesh::cli {
 namespace {
@@ -30,7 +33,14 @@ std::string point(const Vec3& p) {
   return buf;
 }
 
-void print_summary(std::ostream& out, const std::string& file, const LoadedMesh& loaded, const MeshSummary& s) {
+/// The mesh's pairs of faces that cross each other (find_self_intersections), or nullopt when it
+/// lies over itself throughout (lies_over_itself: not counted). A mesh that crosses itself is no
+/// valid solid for finite elements or a simulation box, and its remeshed surface crosses itself
+/// where it does.
+using Crossing = std::optional<std::size_t>;
+
+void print_summary(std::ostream& out, const std::string& file, const LoadedMesh& loaded, const MeshSummary& s,
+                   const Crossing& crossing) {
   out << file << " (" << format_name(loaded.format) << ")\n";
   out << "  vertices        " << s.vertices << "\n";
   out << "  faces           " << s.faces << "\n";
@@ -55,6 +65,12 @@ void print_summary(std::ostream& out, const std::string& file, const LoadedMesh&
   out << "  edge length     mean " << fmt(s.mean_edge) << ", min " << fmt(s.min_edge) << ", max "
       << fmt(s.max_edge) << "\n";
   out << "  area            " << fmt(s.area) << "\n";
+  if (!crossing)
+    out << "  crossing faces  not counted: the surface lies over itself throughout (a part duplicated in place, "
+           "stacked shells)\n";
+  else
+    out << "  crossing faces  " << *crossing << " pairs"
+        << (*crossing ? " (faces passing through each other: the surface crosses itself)" : "") << "\n";
   if (loaded.repairs.empty()) {
     out << "repairs: none\n";
   } else {
@@ -65,9 +81,12 @@ void print_summary(std::ostream& out, const std::string& file, const LoadedMesh&
 
 /// The API's summary JSON (same field names as remeshd), plus the file, its format and the
 /// per-component details the text output shows.
-std::string info_json(const std::string& file, const LoadedMesh& loaded, const MeshSummary& s) {
+std::string info_json(const std::string& file, const LoadedMesh& loaded, const MeshSummary& s,
+                      const Crossing& crossing) {
   nlohmann::json j = summary_json(s, loaded.repairs);
   j["file"] = file;
+  j["crossing_pairs"] = crossing ? nlohmann::json(*crossing) : nlohmann::json(nullptr);
+  j["layered"] = !crossing;
   j["format"] = std::string(format_name(loaded.format));
   nlohmann::json components = nlohmann::json::array();
   for (const auto& c : s.per_component)
@@ -85,7 +104,8 @@ int run_info(const std::vector<std::string>& args) {
     std::cout << format_help("remesh info MESH [--json] [--weld]",
                              "Reads MESH (obj, off, ply, stl, gltf, glb), validates and repairs it, and prints\n"
                              "its summary: counts, components, boundary loops, Euler characteristic, genus of\n"
-                             "each closed component, bounding box, edge lengths, and every repair made.",
+                             "each closed component, bounding box, edge lengths, the pairs of faces that cross\n"
+                             "each other, and every repair made.",
                              kSpec);
     return 0;
   }
@@ -96,10 +116,12 @@ int run_info(const std::vector<std::string>& args) {
   options.weld = a.has("weld");
   const LoadedMesh loaded = read_mesh_file(file, options);
   const MeshSummary summary = summarize(loaded.mesh);
+  Crossing crossing;
+  if (const auto pairs = find_self_intersections_unless_layered(loaded.mesh, 0)) crossing = pairs->size();
   if (a.has("json"))
-    std::cout << info_json(file, loaded, summary) << "\n";
+    std::cout << info_json(file, loaded, summary, crossing) << "\n";
   else
-    print_summary(std::cout, file, loaded, summary);
+    print_summary(std::cout, file, loaded, summary, crossing);
   return 0;
 }
 

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "run_process.h"
+#include "remesh/self_intersections.h"
 #include "support/mesh_generators.h"
 
 namespace fs = std::filesystem;
@@ -128,7 +129,6 @@ TEST_CASE("bad arguments exit with 2 and one line on stderr", "[cli]") {
       {{"dual", dir.file("missing.obj"), dir.file("d.obj")}, "missing.obj"},
       {{"frobnicate"}, "frobnicate"},
   };
-#ifdef REMESH_CLI_HAS_REMESHER
   const std::string out = dir.file("out.obj");
   cases.push_back({{mesh, out, "--emax", "0.3"}, "--emin"});
   cases.push_back({{mesh, out, "--emin", "0.3"}, "--emax"});
@@ -138,9 +138,7 @@ TEST_CASE("bad arguments exit with 2 and one line on stderr", "[cli]") {
   cases.push_back({{mesh, out, "--emin", "0.2", "--emax", "0.3", "--bogus", "1"}, "--bogus"});
   cases.push_back({{dir.file("missing.obj"), out, "--emin", "0.2", "--emax", "0.3"}, "missing.obj"});
   cases.push_back({{mesh, out, "--emin", "0.2", "--emax", "0.3", "--stats", dir.file("s.txt")}, "--stats"});
-#endif
   fs::create_directory(dir.file("taken.obj"));
-#ifdef REMESH_CLI_HAS_REMESHER
   cases.push_back({{mesh, "/proc/out.obj", "--emin", "0.2", "--emax", "0.3"}, "/proc"});
   cases.push_back({{mesh, out, "--emin", "0.2", "--emax", "0.3", "--dual", "/proc/d.xyz"}, "/proc"});
   // The statistics file too: it was found unwritable only after the run (exit 1, the mesh written).
@@ -148,7 +146,6 @@ TEST_CASE("bad arguments exit with 2 and one line on stderr", "[cli]") {
   cases.push_back({{mesh, out, "--emin", "0.2", "--emax", "0.3", "--stats", dir.file("no_such_dir/s.json")},
                    "--stats: output directory does not exist"});
   cases.push_back({{mesh, out, "--emin", "0.2", "--emax", "0.3", "--stats", dir.file("taken.obj")}, "--stats"});
-#endif
   for (const auto& c : cases) {
     std::string joined;
     for (const auto& a : c.args) joined += a + " ";
@@ -215,6 +212,37 @@ TEST_CASE("info --json has the counts of a generated mesh", "[cli]") {
   const ProcessResult text = remesh_cli({"info", dir.file("sphere.obj")});
   CHECK(text.exit_code == 0);
   CHECK(text.out.find(std::to_string(sphere.n_faces())) != std::string::npos);
+}
+
+TEST_CASE("info counts the faces that cross each other, or says the surface lies over itself", "[cli]") {
+  TempDir dir;
+  // Two balls overlapping (one mesh of two components): their faces cross along a circle.
+  TriMesh two = remesh::test::make_icosphere(3);
+  {
+    const TriMesh other = remesh::test::make_icosphere(3);
+    std::vector<OpenMesh::VertexHandle> added;
+    for (auto v : other.vertices()) added.push_back(two.add_vertex(other.point(v) + remesh::Vec3(1.2, 0.013, 0.007)));
+    for (auto f : other.faces()) {
+      std::vector<OpenMesh::VertexHandle> corners;
+      for (auto v : other.fv_range(f)) corners.push_back(added[v.idx()]);
+      two.add_face(corners);
+    }
+  }
+  write_obj(two, dir.file("two.obj"));
+  write_obj(remesh::test::make_icosphere(3), dir.file("one.obj"));
+  write_obj(remesh::test::stacked_copies(remesh::test::make_icosphere(2), 16), dir.file("stack.obj"));
+  const auto t = info_json(dir.file("two.obj"));
+  CHECK(t.at("crossing_pairs") == remesh::find_self_intersections(two, 1).size());
+  CHECK(t.at("crossing_pairs").get<std::size_t>() > 0);
+  CHECK(t.at("layered") == false);
+  CHECK(info_json(dir.file("one.obj")).at("crossing_pairs") == 0);
+  const auto s = info_json(dir.file("stack.obj"));
+  CHECK(s.at("crossing_pairs").is_null());
+  CHECK(s.at("layered") == true);
+  const ProcessResult text = remesh_cli({"info", dir.file("two.obj")});
+  CHECK(text.out.find("crossing faces  " + std::to_string(t.at("crossing_pairs").get<std::size_t>()) + " pairs") !=
+        std::string::npos);
+  CHECK(remesh_cli({"info", dir.file("stack.obj")}).out.find("lies over itself throughout") != std::string::npos);
 }
 
 TEST_CASE("info reports repairs: a quad mesh is triangulated", "[cli]") {
@@ -289,7 +317,6 @@ TEST_CASE("dual writes one polygon per interior vertex", "[cli]") {
   CHECK(data.find("\n\n" + counts) != std::string::npos);
 }
 
-#ifdef REMESH_CLI_HAS_REMESHER
 TEST_CASE("a short remesh run writes the mesh, the dual and one stats row per iteration", "[cli]") {
   TempDir dir;
   write_obj(remesh::test::make_icosphere(2), dir.file("sphere.obj"));
@@ -592,4 +619,3 @@ TEST_CASE("Ctrl-C stops the run and the partial mesh is still written", "[cli]")
   const auto stats = nlohmann::json::parse(read_text(dir.file("stats.json")));
   CHECK(stats.size() < 1000);
 }
-#endif
