@@ -64,7 +64,8 @@ void ear_clip_large(const std::vector<P2>& p, const std::int64_t* idx, std::size
   const double cell_x = (hi_x - lo_x) / static_cast<double>(side), cell_y = (hi_y - lo_y) / static_cast<double>(side);
   auto cell_of = [&](double v, double lo, double size) {
     const double k = size > 0 ? std::floor((v - lo) / size) : 0.0;
-    return static_cast<std::size_t>(std::clamp(k, 0.0, static_cast<double>(side - 1)));
+    // Not a number (a box so wide its size overflowed: inf / inf) counts as the first cell.
+    return k > 0 ? static_cast<std::size_t>(std::min(k, static_cast<double>(side - 1))) : std::size_t{0};
   };
   std::vector<std::size_t> start(side * side + 1, 0), in_cell(reflex_corners.size());
   for (std::size_t r : reflex_corners) ++start[cell_of(p[r].y, lo_y, cell_y) * side + cell_of(p[r].x, lo_x, cell_x) + 1];
