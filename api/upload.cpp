@@ -4,6 +4,7 @@
 #include <cctype>
 
 #include "io/summary.h"
+#include "remesh/self_intersections.h"
 
 namespace remesh::api {
 
@@ -165,6 +166,11 @@ PreparedJob prepare_job(std::string_view bytes, std::string_view filename, std::
   r.filename = filename.empty() ? "mesh." + r.format : utf8_prefix(filename, 200);
   r.bytes = bytes.size();
   r.summary = summarize(job.mesh.mesh);
+  // The input's faces that cross each other (remesh info's line), on the request's own thread
+  // (the cores are the running jobs'): nefertiti's 100 000 faces about 0.1 s, beside its reading.
+  const auto crossing = find_self_intersections_unless_layered(job.mesh.mesh, 1);
+  r.summary["crossing_pairs"] = crossing ? nlohmann::json(crossing->size()) : nlohmann::json(nullptr);
+  r.summary["layered"] = !crossing;
   r.repairs = job.mesh.repairs;
   return job;
 }

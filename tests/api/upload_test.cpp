@@ -5,6 +5,7 @@
 
 #include "api/upload.h"
 #include "io/mesh_io.h"
+#include "remesh/self_intersections.h"
 #include "support/mesh_generators.h"
 
 using namespace remesh;
@@ -78,8 +79,20 @@ TEST_CASE("prepare_job validates, reads and summarises", "[api][upload]") {
   CHECK(job.record.summary["faces"] == job.mesh.mesh.n_faces());
   CHECK(job.record.summary["genus"] == nlohmann::json::array({0}));
   CHECK(job.record.params.iterations == 3);
+  CHECK(job.record.summary["crossing_pairs"] == 0);
+  CHECK(job.record.summary["layered"] == false);
   // Sniffed when no format is given.
   CHECK(prepare_job(obj, "", std::nullopt, good_params(), {}).record.format == "obj");
+  // The faces that cross each other: two balls overlapping cross along a circle (as many pairs as
+  // a recount finds); sixteen at one place lie over each other throughout.
+  const TriMesh two = test::stacked_copies(make_icosphere(2), 2, Vec3(1.2, 0.013, 0.007));  // the second moved
+  const PreparedJob crossing = prepare_job(write_mesh(two, Format::Obj), "two.obj", Format::Obj, good_params(), {});
+  CHECK(crossing.record.summary["crossing_pairs"] == find_self_intersections(crossing.mesh.mesh, 1).size());
+  CHECK(crossing.record.summary["crossing_pairs"].get<std::size_t>() > 0);
+  const PreparedJob stack = prepare_job(write_mesh(test::stacked_copies(make_icosphere(2), 16), Format::Obj),
+                                        "stack.obj", Format::Obj, good_params(), {});
+  CHECK(stack.record.summary["crossing_pairs"].is_null());
+  CHECK(stack.record.summary["layered"] == true);
 }
 
 TEST_CASE("prepare_job: the errors it must give", "[api][upload]") {

@@ -97,6 +97,8 @@ TEST_CASE("remeshd: submit raw and multipart, follow, download, list, delete", "
   CHECK(done["thin_parts"]["limit"].get<double>() == Approx(0.4 / std::sqrt(3.0)));
   CHECK(done["crossing_pairs"] == 0);  // a ball's result does not cross itself
   CHECK(done["layered"] == false);
+  CHECK(done["input"]["summary"]["crossing_pairs"] == 0);  // nor does the ball
+  CHECK(done["input"]["summary"]["layered"] == false);
   // The result's triangles: as many as a closed ball of its vertices and edges has (F = E - V + 2).
   const json& tri = done["triangles"];
   CHECK(tri["faces"] == done["latest"]["edges"].get<int>() - done["latest"]["vertices"].get<int>() + 2);
@@ -241,6 +243,9 @@ TEST_CASE("remeshd: a job whose mesh lies over itself throughout is said to be l
   auto r = submit_raw(c, mesh, "emin=0.2&emax=0.35&filename=stack.obj");
   REQUIRE(r);
   REQUIRE(r->status == 202);
+  // The input says so from the start, as the result does at the end.
+  CHECK(body_of(r)["input"]["summary"]["layered"] == true);
+  CHECK(body_of(r)["input"]["summary"]["crossing_pairs"].is_null());
   const json done = wait_final(c, body_of(r)["id"]);
   REQUIRE(done["state"] == "succeeded");
   CHECK(done["layered"] == true);
