@@ -168,7 +168,7 @@ PreparedJob prepare_job(std::string_view bytes, std::string_view filename, std::
   r.summary = summarize(job.mesh.mesh);
   // The input's faces that cross each other (remesh info's line), on the request's own thread
   // (the cores are the running jobs'): nefertiti's 100 000 faces about 0.1 s, beside its reading.
-  const auto crossing = find_self_intersections_unless_layered(job.mesh.mesh, 1);
+  const auto crossing = find_input_self_intersections(job.mesh.mesh, 1);
   r.summary["crossing_pairs"] = crossing ? nlohmann::json(crossing->size()) : nlohmann::json(nullptr);
   r.summary["layered"] = !crossing;
   r.repairs = job.mesh.repairs;

@@ -33,8 +33,8 @@ std::string point(const Vec3& p) {
   return buf;
 }
 
-/// The mesh's pairs of faces that cross each other (find_self_intersections), or nullopt when it
-/// lies over itself throughout (lies_over_itself: not counted). A mesh that crosses itself is no
+/// The mesh's pairs of faces that cross each other (find_input_self_intersections), or nullopt when
+/// too many of its faces overlap to count them. A mesh that crosses itself is no
 /// valid solid for finite elements or a simulation box, and its remeshed surface crosses itself
 /// where it does.
 using Crossing = std::optional<std::size_t>;
@@ -66,8 +66,8 @@ void print_summary(std::ostream& out, const std::string& file, const LoadedMesh&
       << fmt(s.max_edge) << "\n";
   out << "  area            " << fmt(s.area) << "\n";
   if (!crossing)
-    out << "  crossing faces  not counted: the surface lies over itself throughout (a part duplicated in place, "
-           "stacked shells)\n";
+    out << "  crossing faces  not counted: too many faces overlap (the surface lies over itself throughout, as a "
+           "part duplicated in place does, or is made of long slivers)\n";
   else
     out << "  crossing faces  " << *crossing << " pairs"
         << (*crossing ? " (faces passing through each other: the surface crosses itself)" : "") << "\n";
@@ -117,7 +117,7 @@ int run_info(const std::vector<std::string>& args) {
   const LoadedMesh loaded = read_mesh_file(file, options);
   const MeshSummary summary = summarize(loaded.mesh);
   Crossing crossing;
-  if (const auto pairs = find_self_intersections_unless_layered(loaded.mesh, 0)) crossing = pairs->size();
+  if (const auto pairs = find_input_self_intersections(loaded.mesh, 0)) crossing = pairs->size();
   if (a.has("json"))
     std::cout << info_json(file, loaded, summary, crossing) << "\n";
   else

@@ -20,6 +20,7 @@
 #include "progress.h"
 #include "remesh/equalize.h"
 #include "remesh/reference_surface.h"
+#include "remesh/self_intersections.h"
 
 namespace remesh::cli {
 namespace {
@@ -137,8 +138,12 @@ void write_text_file(const std::string& path, const std::string& text) {
   if (!f.flush()) throw std::runtime_error("write failed: " + path);
 }
 
+/// The input's pairs of faces that cross each other (find_input_self_intersections), or nullopt when
+/// too many of its faces overlap to count them, for the summary's crossing line beside the result's.
+using InputCrossings = std::optional<std::size_t>;
+
 void print_final(const TriMesh& mesh, const Job& job, const Result& result, const std::optional<DualStats>& dual,
-                 const std::optional<BondRelaxation>& relaxed) {
+                 const std::optional<BondRelaxation>& relaxed, const InputCrossings& input_crossings) {
   const IterationStats q = measure(mesh, job.params.e_min, job.params.e_max, job.params.threads);
   const MeshSummary s = summarize(mesh);
   std::printf("result: %zu vertices, %zu edges, %zu faces\n", s.vertices, s.edges, s.faces);
@@ -155,11 +160,17 @@ void print_final(const TriMesh& mesh, const Job& job, const Result& result, cons
   if (result.layered)
     std::printf("  crossing faces:       not counted: the surface lies over itself throughout, as a part duplicated "
                 "in place or stacked shells do (not untangled)\n");
-  else if (result.crossing_pairs)
-    std::printf("  crossing faces:       %zu pairs%s\n", *result.crossing_pairs,
-                *result.crossing_pairs == 0 ? ""
-                                            : " (faces passing through each other: where the input crosses itself, "
-                                              "or where parts are thinner than the edges)");
+  else if (result.crossing_pairs) {
+    std::string input = input_crossings ? std::to_string(*input_crossings) + " pairs" : "not counted";
+    if (*result.crossing_pairs > 0)
+      std::printf("  crossing faces:       %zu pairs (the input: %s; faces passing through each other: where the input "
+                  "crosses itself, or where parts are thinner than the edges)\n",
+                  *result.crossing_pairs, input.c_str());
+    else if (input_crossings != std::optional<std::size_t>(0))
+      std::printf("  crossing faces:       0 pairs (the input: %s)\n", input.c_str());
+    else
+      std::printf("  crossing faces:       0 pairs\n");
+  }
   std::printf("  regular vertices:     %.2f %%\n", q.regular_percent);
   if (const ThinParts& t = result.thin; t.vertices_thinner > 0 && t.vertices_thicker > 0) {
     auto percent = [](std::size_t part, std::size_t whole) { return 100.0 * double(part) / double(whole); };
@@ -219,6 +230,11 @@ int run_remesh(const std::vector<std::string>& args) {
   if (job.dual_out) reference.emplace(loaded.mesh);
 
   TriMesh& mesh = loaded.mesh;
+  // The input's crossing faces, for the summary (a search of the input: nefertiti's 100 000 faces
+  // about 0.05 s).
+  InputCrossings input_crossings;
+  if (!job.quiet)
+    if (const auto pairs = find_input_self_intersections(mesh, job.params.threads)) input_crossings = pairs->size();
   std::vector<IterationStats> rows;
   Progress progress(job.params.iterations, job.quiet);
   const Result result = equalize(
@@ -244,7 +260,7 @@ int run_remesh(const std::vector<std::string>& args) {
     const bool json = job.stats_out->size() > 5 && job.stats_out->ends_with(".json");
     write_text_file(*job.stats_out, json ? nlohmann::json(rows).dump(2) + "\n" : stats_to_csv(rows));
   }
-  if (!job.quiet) print_final(mesh, job, result, dual_summary, relaxed);
+  if (!job.quiet) print_final(mesh, job, result, dual_summary, relaxed, input_crossings);
   if (result.outcome == Outcome::Cancelled) {
     std::cerr << "remesh: cancelled after " << result.iterations_done << " iterations; wrote the partial mesh to "
               << job.out << "\n";

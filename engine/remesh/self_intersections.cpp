@@ -352,19 +352,19 @@ struct alignas(64) BlockFinds {
 
 /// The broad phase over every live face, counting the pairs of overlapping spheres and, with
 /// `cross`, collecting the pairs that cross (find_self_intersections); nullopt once more than
-/// kLayeredOverlapsPerFace pairs a face overlap. Each block adds its count to the shared one every
-/// kShare pairs, and the blocks stop once that is over the limit. Over the limit only when more
-/// than `limit` pairs overlap, and exact when the blocks ran to their end: the answer does not
-/// depend on the threads' timing.
+/// `limit` pairs overlap (0: kLayeredOverlapsPerFace a face). Each block adds its count to the
+/// shared one every kShare pairs, and the blocks stop once that is over the limit. Over the limit
+/// only when more than `limit` pairs overlap, and exact when the blocks ran to their end: the
+/// answer does not depend on the threads' timing.
 std::optional<std::vector<std::pair<unsigned, unsigned>>> unless_layered(const TriMesh& mesh, unsigned threads,
-                                                                        bool cross) {
+                                                                        bool cross, std::size_t limit = 0) {
   const FaceSpheres spheres = face_spheres(mesh);
   std::vector<unsigned> faces;
   faces.reserve(mesh.n_faces());
   for (std::size_t i = 0; i < mesh.n_faces(); ++i)
     if (!mesh.has_face_status() || !mesh.status(OpenMesh::FaceHandle(static_cast<int>(i))).deleted())
       faces.push_back(static_cast<unsigned>(i));
-  const std::size_t limit = kLayeredOverlapsPerFace * faces.size();
+  if (limit == 0) limit = kLayeredOverlapsPerFace * faces.size();
   constexpr std::size_t kShare = 4096;
   std::atomic<std::size_t> shared{0};
   std::atomic<bool> over{false};
@@ -392,6 +392,12 @@ bool lies_over_itself(const TriMesh& mesh, unsigned threads) { return !unless_la
 std::optional<std::vector<std::pair<unsigned, unsigned>>> find_self_intersections_unless_layered(const TriMesh& mesh,
                                                                                                 unsigned threads) {
   return unless_layered(mesh, threads, true);
+}
+
+std::optional<std::vector<std::pair<unsigned, unsigned>>> find_input_self_intersections(const TriMesh& mesh,
+                                                                                       unsigned threads) {
+  return unless_layered(mesh, threads, true,
+                        std::max(kLayeredOverlapsPerFace * mesh.n_faces(), kInputOverlapsAtLeast));
 }
 
 }  // namespace remesh

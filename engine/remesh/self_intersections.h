@@ -86,4 +86,16 @@ bool lies_over_itself(const TriMesh& mesh, unsigned threads);
 std::optional<std::vector<std::pair<unsigned, unsigned>>> find_self_intersections_unless_layered(const TriMesh& mesh,
                                                                                                 unsigned threads);
 
+/// Pairs of overlapping face spheres an input's search may meet, at least, whatever its face count.
+constexpr std::size_t kInputOverlapsAtLeast = 20'000'000;
+
+/// The same for an input mesh, to tell the user (remesh info, the job's input summary): an input
+/// may have long slivers whose spheres overlap many faces (cheese.off: 125 pairs a face, where
+/// kLayeredOverlapsPerFace would call it layered), so its search stops only past
+/// max(kLayeredOverlapsPerFace a face, kInputOverlapsAtLeast) pairs: cheese's 2.2 million are
+/// counted; an icosahedron 2 048 times at one place (24 000 a face) is not. Nullopt: not counted,
+/// the input lies over itself throughout or is made of long slivers.
+std::optional<std::vector<std::pair<unsigned, unsigned>>> find_input_self_intersections(const TriMesh& mesh,
+                                                                                       unsigned threads);
+
 }  // namespace remesh

@@ -84,15 +84,20 @@ TEST_CASE("prepare_job validates, reads and summarises", "[api][upload]") {
   // Sniffed when no format is given.
   CHECK(prepare_job(obj, "", std::nullopt, good_params(), {}).record.format == "obj");
   // The faces that cross each other: two balls overlapping cross along a circle (as many pairs as
-  // a recount finds); sixteen at one place lie over each other throughout.
+  // a recount finds); sixteen at one place touch everywhere but cross nowhere (their faces share
+  // their corners' positions); 1 024 overlap too much to count (over 20 million pairs of spheres).
   const TriMesh two = test::stacked_copies(make_icosphere(2), 2, Vec3(1.2, 0.013, 0.007));  // the second moved
   const PreparedJob crossing = prepare_job(write_mesh(two, Format::Obj), "two.obj", Format::Obj, good_params(), {});
   CHECK(crossing.record.summary["crossing_pairs"] == find_self_intersections(crossing.mesh.mesh, 1).size());
   CHECK(crossing.record.summary["crossing_pairs"].get<std::size_t>() > 0);
   const PreparedJob stack = prepare_job(write_mesh(test::stacked_copies(make_icosphere(2), 16), Format::Obj),
                                         "stack.obj", Format::Obj, good_params(), {});
-  CHECK(stack.record.summary["crossing_pairs"].is_null());
-  CHECK(stack.record.summary["layered"] == true);
+  CHECK(stack.record.summary["crossing_pairs"] == 0);
+  CHECK(stack.record.summary["layered"] == false);
+  const PreparedJob pile = prepare_job(write_mesh(test::stacked_copies(make_icosphere(1), 1024), Format::Obj),
+                                       "pile.obj", Format::Obj, good_params(), {});
+  CHECK(pile.record.summary["crossing_pairs"].is_null());
+  CHECK(pile.record.summary["layered"] == true);
 }
 
 TEST_CASE("prepare_job: the errors it must give", "[api][upload]") {

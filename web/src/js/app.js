@@ -138,7 +138,7 @@ function show_summary(s, source) {
   }
   if (s.bbox) add('bbox diagonal', fmt(s.bbox.diagonal));
   add('area', Number.isFinite(s.area) ? fmt(s.area) : undefined);
-  if (s.layered) add('crossing faces', 'lies over itself throughout');
+  if (s.layered) add('crossing faces', 'not counted (too many faces overlap)');
   else add('crossing faces', Number.isFinite(s.crossing_pairs) ? `${n(s.crossing_pairs)} pairs` : undefined);
   dl.append(Object.assign(document.createElement('dd'), { className: 'src', textContent: source }));
 }
