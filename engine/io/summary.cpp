@@ -18,6 +18,16 @@ namespace {
 /// squares it does not (they read "inf"). Its area is another matter: 1e600 is no double.
 double length(const Vec3& d) { return std::hypot(d[0], d[1], d[2]); }
 
+/// The triangle's area, infinite rather than not a number where it overflows: corners 3e308 apart
+/// overflow their differences to inf, whose cross product mixes inf and 0 into NaN. Such a
+/// triangle is measured in coordinates scaled by its largest one.
+double triangle_area(const Vec3& a, const Vec3& b, const Vec3& c) {
+  const double area = 0.5 * OpenMesh::cross(b - a, c - a).norm();
+  if (std::isfinite(area)) return area;
+  const double k = std::max({a.max_abs(), b.max_abs(), c.max_abs()});
+  return 0.5 * OpenMesh::cross(b / k - a / k, c / k - a / k).norm() * k * k;
+}
+
 }  // namespace
 
 MeshSummary summarize(const TriMesh& mesh) {
@@ -73,7 +83,7 @@ MeshSummary summarize(const TriMesh& mesh) {
     ++comp_of(mesh.to_vertex_handle(h)).faces;
     const Vec3 a = mesh.point(mesh.from_vertex_handle(h)), b = mesh.point(mesh.to_vertex_handle(h)),
                c = mesh.point(mesh.to_vertex_handle(mesh.next_halfedge_handle(h)));
-    s.area += 0.5 * OpenMesh::cross(b - a, c - a).norm();
+    s.area += triangle_area(a, b, c);
   }
   std::vector<bool> seen(mesh.n_halfedges(), false);
   for (auto h : mesh.halfedges()) {

@@ -48,7 +48,8 @@ namespace remesh {
 class FeatureSnap {
  public:
   /// Collects the interior vertices of `reference` (a valid mesh, typically the input) and, when
-  /// `crease_spacing` > 0, points along its creases at most that far apart (see the file comment).
+  /// `crease_spacing` > 0, points along its creases at most that far apart (see the file comment),
+  /// each position once however often the reference repeats it (parts laid over each other).
   explicit FeatureSnap(const TriMesh& reference, double crease_spacing = 0);
 
   /// The snap of a run's last iteration: up to kSnapPasses passes within the budget. Precondition:

@@ -88,6 +88,13 @@ TEST_CASE("Summary of a mesh 1e300 across: lengths a double holds are not overfl
   CHECK(s.min_edge == Approx(1e300));
   CHECK(s.max_edge == Approx(std::sqrt(2.0) * 1e300));
   CHECK(std::isfinite(s.mean_edge));
+  // Corners 3e308 apart: their differences overflow, and the area (1e616) is infinite, not NaN.
+  const LoadedMesh far = read_mesh("v -1.5e308 0 0\nv 1.5e308 0 0\nv 0 1.5e308 0\nv 0 0 1.5e308\n"
+                                   "f 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n",
+                                   ReadOptions{Format::Obj});
+  const MeshSummary f = summarize(far.mesh);
+  CHECK(std::isinf(f.area));
+  CHECK(f.area > 0);
   // The same lengths as before on an ordinary mesh.
   const MeshSummary unit = summarize(test::make_icosphere(1));
   CHECK(unit.bbox_diagonal == Approx(2 * std::sqrt(3.0)).epsilon(0.2));
