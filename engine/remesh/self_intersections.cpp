@@ -301,15 +301,32 @@ void for_overlapping_spheres(const FaceSpheres& spheres, const std::vector<unsig
   });
 }
 
-}  // namespace
+/// What one block of the broad phase found: its crossing pairs (when asked for) and how many pairs
+/// of overlapping spheres it met. A cache line each: two threads count into neighbouring blocks.
+struct alignas(64) BlockFinds {
+  std::vector<std::pair<unsigned, unsigned>> pairs;
+  std::size_t overlaps = 0;
+};
 
-std::vector<std::pair<unsigned, unsigned>> find_self_intersections(const TriMesh& mesh, unsigned threads,
-                                                                   const Box* region) {
+/// Pairs of overlapping spheres a search may meet: `per_face` a face looked at, and at least
+/// `at_least`; no limit without `per_face`.
+struct OverlapLimit {
+  std::optional<std::size_t> per_face;
+  std::size_t at_least = 0;
+};
+
+/// The search behind find_self_intersections and its variants. The faces looked at: all, or those
+/// within reach of `region` (the faces meeting it, and every face that can cross one of them: its
+/// sphere meets theirs, so it meets the region grown by their largest diameter); deleted faces are
+/// passed over (face_spheres leaves them a sphere of radius 0 at the origin). With `cross`, the
+/// pairs that cross are collected (with a region, those with a face meeting it). With a limit, the
+/// pairs of overlapping spheres are counted, each block adding its count to the shared one every
+/// kShare pairs, and the blocks stop once that is over the limit: nullopt then. Over the limit only
+/// when more pairs than the limit overlap, and exact when the blocks ran to their end: the answer
+/// does not depend on the threads' timing.
+std::optional<std::vector<std::pair<unsigned, unsigned>>> search(const TriMesh& mesh, unsigned threads,
+                                                                const Box* region, bool cross, OverlapLimit limit) {
   const FaceSpheres spheres = face_spheres(mesh);
-  // The faces looked at: all, or those within reach of the region (the faces meeting it, and every
-  // face that can cross one of them: its sphere meets theirs, so it meets the region grown by
-  // their largest diameter).
-  // Deleted faces are passed over (face_spheres leaves them a sphere of radius 0 at the origin).
   auto live = [&](std::size_t i) {
     return !mesh.has_face_status() || !mesh.status(OpenMesh::FaceHandle(static_cast<int>(i))).deleted();
   };
@@ -329,56 +346,25 @@ std::vector<std::pair<unsigned, unsigned>> find_self_intersections(const TriMesh
     for (std::size_t i = 0; i < mesh.n_faces(); ++i)
       if (live(i)) faces.push_back(static_cast<unsigned>(i));
   }
-  std::vector<std::vector<std::pair<unsigned, unsigned>>> found;
-  for_overlapping_spheres(spheres, faces, threads, [&](unsigned i, unsigned j, std::size_t block) {
-    if (region && !in_region[i] && !in_region[j]) return;
-    if (corners_cross(mesh, spheres.corners[i], spheres.corners[j]))
-      found[block].emplace_back(std::min(i, j), std::max(i, j));
-  }, found);
-  std::vector<std::pair<unsigned, unsigned>> pairs;
-  for (auto& b : found) pairs.insert(pairs.end(), b.begin(), b.end());
-  std::sort(pairs.begin(), pairs.end());
-  return pairs;
-}
-
-namespace {
-
-/// What one block of the broad phase found: its crossing pairs (when asked for) and how many pairs
-/// of overlapping spheres it met. A cache line each: two threads count into neighbouring blocks.
-struct alignas(64) BlockFinds {
-  std::vector<std::pair<unsigned, unsigned>> pairs;
-  std::size_t overlaps = 0;
-};
-
-/// The broad phase over every live face, counting the pairs of overlapping spheres and, with
-/// `cross`, collecting the pairs that cross (find_self_intersections); nullopt once more than
-/// `limit` pairs overlap (0: kLayeredOverlapsPerFace a face). Each block adds its count to the
-/// shared one every kShare pairs, and the blocks stop once that is over the limit. Over the limit
-/// only when more than `limit` pairs overlap, and exact when the blocks ran to their end: the
-/// answer does not depend on the threads' timing.
-std::optional<std::vector<std::pair<unsigned, unsigned>>> unless_layered(const TriMesh& mesh, unsigned threads,
-                                                                        bool cross, std::size_t limit = 0) {
-  const FaceSpheres spheres = face_spheres(mesh);
-  std::vector<unsigned> faces;
-  faces.reserve(mesh.n_faces());
-  for (std::size_t i = 0; i < mesh.n_faces(); ++i)
-    if (!mesh.has_face_status() || !mesh.status(OpenMesh::FaceHandle(static_cast<int>(i))).deleted())
-      faces.push_back(static_cast<unsigned>(i));
-  if (limit == 0) limit = kLayeredOverlapsPerFace * faces.size();
+  const bool limited = limit.per_face.has_value();
+  const std::size_t most = limited ? std::max(*limit.per_face * faces.size(), limit.at_least) : 0;
   constexpr std::size_t kShare = 4096;
   std::atomic<std::size_t> shared{0};
   std::atomic<bool> over{false};
   std::vector<BlockFinds> found;
   for_overlapping_spheres(spheres, faces, threads, [&](unsigned i, unsigned j, std::size_t block) {
     BlockFinds& b = found[block];
-    if (++b.overlaps % kShare == 0 && shared.fetch_add(kShare, std::memory_order_relaxed) + kShare > limit)
+    if (limited && ++b.overlaps % kShare == 0 && shared.fetch_add(kShare, std::memory_order_relaxed) + kShare > most)
       over.store(true, std::memory_order_relaxed);
-    if (cross && corners_cross(mesh, spheres.corners[i], spheres.corners[j]))
+    if (!cross || (region && !in_region[i] && !in_region[j])) return;
+    if (corners_cross(mesh, spheres.corners[i], spheres.corners[j]))
       b.pairs.emplace_back(std::min(i, j), std::max(i, j));
-  }, found, &over);
-  std::size_t total = 0;
-  for (const BlockFinds& b : found) total += b.overlaps;
-  if (over.load() || total > limit) return std::nullopt;
+  }, found, limited ? &over : nullptr);
+  if (limited) {
+    std::size_t total = 0;
+    for (const BlockFinds& b : found) total += b.overlaps;
+    if (over.load() || total > most) return std::nullopt;
+  }
   std::vector<std::pair<unsigned, unsigned>> pairs;
   for (BlockFinds& b : found) pairs.insert(pairs.end(), b.pairs.begin(), b.pairs.end());
   std::sort(pairs.begin(), pairs.end());
@@ -387,17 +373,23 @@ std::optional<std::vector<std::pair<unsigned, unsigned>>> unless_layered(const T
 
 }  // namespace
 
-bool lies_over_itself(const TriMesh& mesh, unsigned threads) { return !unless_layered(mesh, threads, false); }
+std::vector<std::pair<unsigned, unsigned>> find_self_intersections(const TriMesh& mesh, unsigned threads,
+                                                                   const Box* region) {
+  return *search(mesh, threads, region, true, {});
+}
+
+bool lies_over_itself(const TriMesh& mesh, unsigned threads) {
+  return !search(mesh, threads, nullptr, false, {kLayeredOverlapsPerFace});
+}
 
 std::optional<std::vector<std::pair<unsigned, unsigned>>> find_self_intersections_unless_layered(const TriMesh& mesh,
                                                                                                 unsigned threads) {
-  return unless_layered(mesh, threads, true);
+  return search(mesh, threads, nullptr, true, {kLayeredOverlapsPerFace});
 }
 
 std::optional<std::vector<std::pair<unsigned, unsigned>>> find_input_self_intersections(const TriMesh& mesh,
                                                                                        unsigned threads) {
-  return unless_layered(mesh, threads, true,
-                        std::max(kLayeredOverlapsPerFace * mesh.n_faces(), kInputOverlapsAtLeast));
+  return search(mesh, threads, nullptr, true, {kLayeredOverlapsPerFace, kInputOverlapsAtLeast});
 }
 
 }  // namespace remesh

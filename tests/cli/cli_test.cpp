@@ -217,17 +217,7 @@ TEST_CASE("info --json has the counts of a generated mesh", "[cli]") {
 TEST_CASE("info counts the faces that cross each other, or says the surface lies over itself", "[cli]") {
   TempDir dir;
   // Two balls overlapping (one mesh of two components): their faces cross along a circle.
-  TriMesh two = remesh::test::make_icosphere(3);
-  {
-    const TriMesh other = remesh::test::make_icosphere(3);
-    std::vector<OpenMesh::VertexHandle> added;
-    for (auto v : other.vertices()) added.push_back(two.add_vertex(other.point(v) + remesh::Vec3(1.2, 0.013, 0.007)));
-    for (auto f : other.faces()) {
-      std::vector<OpenMesh::VertexHandle> corners;
-      for (auto v : other.fv_range(f)) corners.push_back(added[v.idx()]);
-      two.add_face(corners);
-    }
-  }
+  const TriMesh two = remesh::test::stacked_copies(remesh::test::make_icosphere(3), 2, remesh::Vec3(1.2, 0.013, 0.007));
   write_obj(two, dir.file("two.obj"));
   write_obj(remesh::test::make_icosphere(3), dir.file("one.obj"));
   // Sixteen copies of a ball at one place touch everywhere but cross nowhere (their faces share

@@ -270,17 +270,7 @@ TEST_CASE("the result counts the faces that cross each other, as a recount of th
   // the result crosses itself along the circle where they meet, as the input does. A torus does not.
   // (The second sphere is not the first's mirror image: mirrored, their faces meet edge to edge on
   // the mirror plane, which the crossing test counts as touching.)
-  TriMesh spheres = test::make_icosphere(3);
-  {
-    const TriMesh other = test::make_icosphere(3);
-    std::vector<OpenMesh::VertexHandle> added;
-    for (auto v : other.vertices()) added.push_back(spheres.add_vertex(other.point(v) + Vec3(1.2, 0.013, 0.007)));
-    for (auto f : other.faces()) {
-      std::vector<OpenMesh::VertexHandle> corners;
-      for (auto v : other.fv_range(f)) corners.push_back(added[v.idx()]);
-      spheres.add_face(corners);
-    }
-  }
+  TriMesh spheres = test::stacked_copies(test::make_icosphere(3), 2, Vec3(1.2, 0.013, 0.007));
   REQUIRE(test::check_mesh_valid(spheres) == "");
   REQUIRE_FALSE(find_self_intersections(spheres, 1).empty());
   TriMesh torus = test::make_torus(48, 16, 3.0, 1.0);
