@@ -539,6 +539,26 @@ Result equalize(TriMesh& mesh, const Params& requested, const OnIteration& on_it
   std::optional<Converged> fewest;  // the mesh of the low of edges outside, once the cleanup runs
   int converged_at = 0, outside_since = 0;  // first convergence; iterations in a row with edges outside
   std::vector<IterationStats> held;  // rows of the polishing iterations, not yet reported
+  // A run that ends with edges outside (stalled, or n reached; with run_all_iterations, any run at
+  // its n-th iteration) returns the mesh of its low: `row` (this iteration's, `outside` edges
+  // outside) then describes it (its counters stay this iteration's), so that the last row is the
+  // returned mesh's. Then the final cleanup (kFinalCleanupRounds) works on it.
+  auto end_at_low = [&](IterationStats& row, std::size_t outside) {
+    const std::size_t low = fewest ? fewest->row.small + fewest->row.big : SIZE_MAX;
+    if (low < outside || (low == outside && fewest->row.regular_percent > row.regular_percent)) {
+      restore_snapshot(mesh, fewest->mesh);
+      row = measured_row(mesh, params, row);
+    }
+    if (stop.stop_requested() || row.small + row.big == 0) return;
+    PhaseTimer timer(phases.cleanup);
+    const CleanupCounts c = run_cleanup(mesh, *reference, params, neighbour_caches, guard.get(), /*final=*/true,
+                                        /*boundary_only=*/false, stop);
+    timer.stop();
+    if (fixes(c) > 0) {
+      count_cleanup(row, c);
+      row = measured_row(mesh, params, row);
+    }
+  };
   auto flush = [&] {
     if (on_iteration)
       for (const IterationStats& r : held) on_iteration(r);
@@ -647,9 +667,8 @@ Result equalize(TriMesh& mesh, const Params& requested, const OnIteration& on_it
     // On open meshes its boundary part runs every iteration (see interval_cleanup.h).
     if (params.cleanup && !stop.stop_requested()) {
       const bool last = i == params.iterations;
-      cleanup_started = cleanup_started || (!params.run_all_iterations &&
-                                            (2 * i > params.iterations || plateaued(history) ||
-                                             inside_fraction(mesh, params, threads) >= kCleanupFrom));
+      cleanup_started = cleanup_started || 2 * i > params.iterations || plateaued(history) ||
+                        inside_fraction(mesh, params, threads) >= kCleanupFrom;
       if (cleanup_started && cleanup_from == 0) cleanup_from = i;
       const bool full = last || cleanup_started;
       if (full || reference->has_boundary()) {
@@ -673,8 +692,10 @@ Result equalize(TriMesh& mesh, const Params& requested, const OnIteration& on_it
     bool restore = false;
     const std::size_t outside = row.small + row.big;
     if (cleanup_started && outside < fewest_outside) fewest_outside = outside, fewest_at = i;
-    // Keep the mesh of the low until the first mesh with every edge inside (then `best` is returned).
-    if (cleanup_started && !all_inside && !best && !params.run_all_iterations && params.cleanup &&
+    // Keep the mesh of the low until the first mesh with every edge inside (then `best` is returned);
+    // with run_all_iterations, which has no `best`, through the whole run, meshes with every edge
+    // inside included.
+    if (cleanup_started && (!all_inside || params.run_all_iterations) && !best && params.cleanup &&
         outside == fewest_outside &&
         (!fewest || fewest->row.small + fewest->row.big > outside ||
          row.regular_percent > fewest->row.regular_percent))
@@ -717,28 +738,11 @@ Result equalize(TriMesh& mesh, const Params& requested, const OnIteration& on_it
       } else if (cleanup_started && i - fewest_at >= stall_span(fewest_outside, row.edges)) {
         outcome = Outcome::Stalled;
       }
-      // A run that ends with edges outside (stalled, or n reached) returns the mesh of its low; this
-      // iteration's row describes it (its counters stay this iteration's), so that the last row is
-      // the returned mesh's.
-      // Then the final cleanup (kFinalCleanupRounds) works on it.
-      if (!best && (outcome == Outcome::Stalled || i == params.iterations)) {
-        const std::size_t low = fewest ? fewest->row.small + fewest->row.big : SIZE_MAX;
-        if (low < outside || (low == outside && fewest->row.regular_percent > row.regular_percent)) {
-          restore_snapshot(mesh, fewest->mesh);
-          row = measured_row(mesh, params, row);
-        }
-        if (!stop.stop_requested()) {
-          PhaseTimer timer(phases.cleanup);
-          const CleanupCounts c =
-              run_cleanup(mesh, *reference, params, neighbour_caches, guard.get(), /*final=*/true,
-                          /*boundary_only=*/false, stop);
-          timer.stop();
-          if (fixes(c) > 0) {
-            count_cleanup(row, c);
-            row = measured_row(mesh, params, row);
-          }
-        }
-      }
+      if (!best && (outcome == Outcome::Stalled || i == params.iterations)) end_at_low(row, outside);
+    } else if (params.run_all_iterations && params.cleanup) {
+      // No early stop (the outcome stays Completed); the n-th iteration ends as a run that reaches
+      // n does, at its low.
+      if (i == params.iterations) end_at_low(row, outside);
     } else if (!params.run_all_iterations && all_inside) {
       outcome = Outcome::Converged;
     }

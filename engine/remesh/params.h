@@ -16,7 +16,11 @@ struct Params {
   int iterations = 100;       ///< n: iterations, 1..max_iterations
   int relax_every = 0;        ///< pr: replace the reference by the current mesh every pr iterations; 0 = never
   double flip_factor = 0.5;   ///< f: a flip may lower the min angle to no less than f * old, 0..1
-  bool run_all_iterations = false;  ///< false: stop early once every edge is inside [e_min, e_max]
+  /// false: stop early once every edge is inside [e_min, e_max] (converged) or the count outside stops
+  /// falling (stalled). true: run all n iterations, the cleanup in the same ones, and return the mesh
+  /// of the run's low (the fewest edges outside, then the most regular vertices) after the final
+  /// cleanup, as a run that reaches n does; the outcome is Completed.
+  bool run_all_iterations = false;
   unsigned threads = 0;       ///< 0 = all cores; results do not depend on it
   int max_iterations = 1000;  ///< upper bound for `iterations` (the service lowers it)
   std::size_t max_output_faces = 20'000'000;  ///< refuse jobs whose estimated output exceeds it; 0 = no limit
