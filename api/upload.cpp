@@ -144,6 +144,7 @@ PreparedJob prepare_job(std::string_view bytes, std::string_view filename, std::
     throw LimitError("the mesh has " + std::to_string(loaded.mesh.n_faces()) + " faces, more than the limit of " +
                      std::to_string(limits.max_faces));
   check_mesh_size(loaded.mesh);
+  check_vertex_stars(loaded.mesh);
   if (auto mesh_errors = check_against(loaded.mesh, params.params); !mesh_errors.empty())
     throw ParamsError(std::move(mesh_errors));
   std::size_t estimate = estimate_output_faces(loaded.mesh, params.params);

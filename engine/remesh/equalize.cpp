@@ -369,6 +369,7 @@ void check_preconditions(const TriMesh& mesh, const Params& params) {
   if (auto errors = check(params); !errors.empty()) throw ParamsError(std::move(errors));
   if (mesh.n_faces() == 0) throw MeshError("the mesh has no faces");
   check_mesh_size(mesh);
+  check_vertex_stars(mesh);
   if (auto errors = check_against(mesh, params); !errors.empty()) throw ParamsError(std::move(errors));
   const std::size_t estimate = estimate_output_faces(mesh, params);
   if (params.max_output_faces > 0 && estimate > params.max_output_faces)
@@ -460,6 +461,19 @@ void check_mesh_size(const TriMesh& mesh) {
                 "(areas would underflow or overflow); scale it, and the interval with it",
                 diagonal, kMinMeshSize, kMaxMeshSize);
   throw MeshError(text);
+}
+
+void check_vertex_stars(const TriMesh& mesh) {
+  for (auto v : mesh.vertices()) {
+    if (mesh.status(v).deleted() || mesh.is_isolated(v) || mesh.is_boundary(v) || mesh.valence(v) >= 3) continue;
+    const Vec3& p = mesh.point(v);
+    char text[320];
+    std::snprintf(text, sizeof text,
+                  "the vertex at (%.9g, %.9g, %.9g) has only %u faces around it: two triangles back to back over "
+                  "the same three corners (a flat part that encloses nothing), which cannot be remeshed; remove them",
+                  p[0], p[1], p[2], mesh.valence(v));
+    throw MeshError(text);
+  }
 }
 
 std::vector<FieldError> check_against(const TriMesh& mesh, const Params& params) {

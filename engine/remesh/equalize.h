@@ -150,6 +150,13 @@ inline constexpr double kMinMeshSize = 1e-30, kMaxMeshSize = 1e30;
 /// [kMinMeshSize, kMaxMeshSize] (or is not finite).
 void check_mesh_size(const TriMesh& mesh);
 
+/// Throws MeshError when an interior vertex has fewer than three faces around it. Such a vertex
+/// has two, over the same three corners: a component that is one flat "pillow" of two triangles
+/// back to back (a tetrahedron whose two corners coincide reads so once its zero-area faces are
+/// repaired), which encloses nothing and which no flip, split or collapse can work on (OpenMesh
+/// asserted in a flip; other such inputs came out non-manifold).
+void check_vertex_stars(const TriMesh& mesh);
+
 /// What check(params) cannot judge without the mesh: e_min must be shorter than the mesh's
 /// bounding-box diagonal, since no edge between two points of its surface is longer (no edge could
 /// end inside the interval). Every invalid field, named as check() names them; empty when valid.

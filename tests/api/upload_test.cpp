@@ -143,6 +143,10 @@ TEST_CASE("prepare_job: the errors it must give", "[api][upload]") {
     CHECK_THROWS_AS(prepare_job("v 0 0 0\nf 1 2 3\n", "x.obj", Format::Obj, good_params(), {}), MeshError);
     CHECK_THROWS_AS(prepare_job("", "x.obj", Format::Obj, good_params(), {}), MeshError);
     CHECK_THROWS_AS(prepare_job("\x01\x02garbage", "x", std::nullopt, good_params(), {}), MeshError);
+    // Two triangles back to back (a tetrahedron with two coincident corners, once repaired).
+    CHECK_THROWS_WITH(prepare_job("v 1 1 0.5\nv 0 0 0\nv 0 0 0\nv 1 0 0\nf 1 3 2\nf 1 2 4\nf 2 3 4\nf 3 1 4\n", "x.obj",
+                                  Format::Obj, good_params(), {}),
+                      Catch::Contains("only 2 faces around it"));
   }
   SECTION("faces and estimated output faces over the limits") {
     UploadLimits limits;

@@ -809,6 +809,30 @@ TEST_CASE("a tiny e_min does not flood the feature snap with crease points", "[e
   CHECK(test::plain_inside_fraction(mesh, p.e_min, p.e_max) > 0.95);
 }
 
+TEST_CASE("two triangles back to back over the same corners are refused, not remeshed", "[equalize]") {
+  // A flat pillow (3 vertices, 2 faces) reads as a closed genus-0 surface whose vertices have two
+  // faces each; a flip on it failed OpenMesh's assertion (a tetrahedron with two coincident corners
+  // reads so once its zero-area faces are repaired). Alone and beside a sphere.
+  for (bool beside : {false, true}) {
+    INFO("beside a sphere " << beside);
+    TriMesh mesh = beside ? test::make_icosphere(2) : TriMesh();
+    const auto a = mesh.add_vertex(Vec3(3, 0, 0)), b = mesh.add_vertex(Vec3(4, 0, 0)), c = mesh.add_vertex(Vec3(3, 1, 0.5));
+    REQUIRE(mesh.add_face(a, b, c).is_valid());
+    REQUIRE(mesh.add_face(b, a, c).is_valid());
+    CHECK_THROWS_AS(check_vertex_stars(mesh), MeshError);
+    Params p;
+    p.e_min = 0.3;
+    p.e_max = 0.5;
+    CHECK_THROWS_WITH(equalize(mesh, p), Catch::Contains("only 2 faces around it") && Catch::Contains("(3, 0, 0)"));
+  }
+  TriMesh sphere = test::make_icosphere(2);
+  CHECK_NOTHROW(check_vertex_stars(sphere));
+  TriMesh open = test::make_icosphere(2);
+  open.delete_face(*open.faces_begin(), false);
+  open.garbage_collection();
+  CHECK_NOTHROW(check_vertex_stars(open));  // boundary vertices may have fewer
+}
+
 TEST_CASE("meshes too small or too large for double arithmetic are refused, saying how large", "[equalize]") {
   for (double scale : {1e-200, 1e-40, 1e40, 1e100}) {
     INFO("scale " << scale);
