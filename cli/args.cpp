@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <charconv>
+#include <climits>
 #include <cmath>
 #include <sstream>
 
@@ -20,6 +21,9 @@ std::optional<double> Args::get_double(const std::string& name) const {
   double value = 0;
   const char* end = text->data() + text->size();
   auto [ptr, ec] = std::from_chars(text->data(), end, value);
+  // A number past the doubles' range (1e400, or 1e-400: from_chars reads neither) is one.
+  if (!text->empty() && ec == std::errc::result_out_of_range && ptr == end)
+    throw ValueError(name, *text + " is beyond the range of double-precision numbers");
   if (text->empty() || ec != std::errc() || ptr != end || !std::isfinite(value))
     throw ValueError(name, "'" + *text + "' is not a number");
   return value;
@@ -31,10 +35,15 @@ std::optional<long long> Args::get_int(const std::string& name, long long lo, lo
   long long value = 0;
   const char* end = text->data() + text->size();
   auto [ptr, ec] = std::from_chars(text->data(), end, value);
+  if (!text->empty() && ec == std::errc::result_out_of_range && ptr == end)
+    throw ValueError(name, *text + " is far too " + (text->front() == '-' ? "small" : "large"));
   if (text->empty() || ec != std::errc() || ptr != end)
     throw ValueError(name, "'" + *text + "' is not an integer");
+  // A range that only keeps the value an int (the option's own rule follows): say which way it is out.
   if (value < lo || value > hi)
-    throw ValueError(name, *text + " is outside " + std::to_string(lo) + ".." + std::to_string(hi));
+    throw ValueError(name, lo <= INT_MIN && hi >= INT_MAX ? *text + " is far too " + (value > hi ? "large" : "small")
+                                                          : *text + " is outside " + std::to_string(lo) + ".." +
+                                                                std::to_string(hi));
   return value;
 }
 

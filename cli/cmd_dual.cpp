@@ -31,6 +31,7 @@ int run_dual(const std::vector<std::string>& args) {
   }
   const Args a = parse_args(args, kSpec, 2, 2);
   const std::string& out = a.positional[1];
+  require_not_input(a.positional[0], "OUT", out);
   const LoadedMesh loaded = read_input_for(a.positional[0], out, a.has("weld"));
   const PolyMesh dual = trivalent_dual(loaded.mesh);
   write_mesh_file(to_soup(dual), out);

@@ -89,7 +89,7 @@ Job parse_job(const std::vector<std::string>& args) {
   if (auto v = read([&] { return a.get_int("rings", INT_MIN, INT_MAX); })) p.rings = static_cast<int>(*v);
   if (auto v = read([&] { return a.get_int("relax-every", INT_MIN, INT_MAX); })) p.relax_every = static_cast<int>(*v);
   if (auto v = read([&] { return a.get_double("flip-factor"); })) p.flip_factor = *v;
-  if (auto v = read([&] { return a.get_int("threads", 0, 4096); })) p.threads = static_cast<unsigned>(*v);
+  if (auto v = read([&] { return a.get_int("threads", 0, 1024); })) p.threads = static_cast<unsigned>(*v);
   if (auto v = read([&] { return a.get_int("max-faces", 0, LLONG_MAX); })) {
     p.max_output_faces = static_cast<std::size_t>(*v);
     job.read.max_faces = static_cast<std::size_t>(*v);
@@ -128,6 +128,8 @@ Job parse_job(const std::vector<std::string>& args) {
   }
   // Before the run: the dual, then the statistics, would silently replace a file written before them.
   require_distinct_outputs({{"OUT", job.out}, {"--dual", job.dual_out}, {"--stats", job.stats_out}});
+  require_not_input(job.in, "--dual", job.dual_out);
+  require_not_input(job.in, "--stats", job.stats_out);
   return job;
 }
 
@@ -225,6 +227,9 @@ int run_remesh(const std::vector<std::string>& args) {
   std::stop_source stop;
   const InterruptGuard guard(stop);
   LoadedMesh loaded = read_mesh_file(job.in, job.read);
+  // A mesh the remesher refuses gets its one line before the repairs are listed.
+  check_mesh_size(loaded.mesh);
+  check_vertex_stars(loaded.mesh);
   if (!job.quiet) print_repairs(std::cerr, loaded.repairs);
   std::optional<ReferenceSurface> reference;
   if (job.dual_out) reference.emplace(loaded.mesh);
@@ -264,6 +269,12 @@ int run_remesh(const std::vector<std::string>& args) {
   if (result.outcome == Outcome::Cancelled) {
     std::cerr << "remesh: cancelled after " << result.iterations_done << " iterations; wrote the partial mesh to "
               << job.out << "\n";
+    return 1;
+  }
+  // Ctrl-C after the run, while the dual's bonds were relaxed: the dual is written as far as it got.
+  if (stop.stop_requested()) {
+    std::cerr << "remesh: cancelled while relaxing the dual's bonds; wrote the mesh to " << job.out
+              << " and the partly relaxed dual to " << *job.dual_out << "\n";
     return 1;
   }
   return 0;

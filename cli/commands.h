@@ -34,6 +34,10 @@ using NamedOutput = std::pair<std::string, std::optional<std::string>>;
 /// Throws UsageError when two of `outputs` name the same file, however spelled ("a.obj",
 /// "./a.obj", "dir/../a.obj", a symbolic or hard link): the later write would replace the earlier.
 void require_distinct_outputs(const std::vector<NamedOutput>& outputs);
+/// Throws UsageError when `path` (an output named `name` on the command line) is the file IN names,
+/// however spelled: the dual or the statistics written over the input mesh lose it. (OUT of the
+/// remeshing and converting commands may replace IN: IN is read before anything is written.)
+void require_not_input(const std::string& in, const std::string& name, const std::optional<std::string>& path);
 /// The prologue of commands that read IN and write OUT: checks IN exists and OUT's format and
 /// directory before reading (so no work is wasted on a bad OUT), then reads IN.
 LoadedMesh read_input_for(const std::string& in, const std::string& out, bool weld);

@@ -1,6 +1,7 @@
 /// \file common.cpp
 /// Helpers shared by the commands.
 
+#include <fcntl.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -40,9 +41,26 @@ void require_writable(const std::string& path) {
   if (!dir.empty() && !std::filesystem::is_directory(dir, ec))
     throw UsageError("output directory does not exist: " + dir.string());
   if (std::filesystem::is_directory(path, ec)) throw UsageError("output is a directory: " + path);
-  // ... and take a file: a file created there and removed at once (a read-only or special file
-  // system, or a directory without write permission, refused the output only after the run).
-  const std::string probe = path + ".remesh-probe-" + std::to_string(::getpid());
+  // A name longer than the file system takes (the probe below has a short name of its own).
+  const std::string name = std::filesystem::path(path).filename().string();
+  const long name_max = ::pathconf(dir.empty() ? "." : dir.c_str(), _PC_NAME_MAX);
+  if (name_max > 0 && name.size() > static_cast<std::size_t>(name_max))
+    throw UsageError("output file name too long (" + std::to_string(name.size()) + " bytes, the file system takes " +
+                     std::to_string(name_max) + "): " + path);
+  // An existing file must take writing (opened without truncating it: it stays as it is).
+  if (std::filesystem::is_regular_file(path, ec)) {
+    const int fd = ::open(path.c_str(), O_WRONLY | O_CLOEXEC);
+    if (fd < 0) {
+      const int error = errno;
+      throw UsageError("cannot write " + path + ": " + std::strerror(error));
+    }
+    ::close(fd);
+  }
+  // ... and the directory take a file: a file created there and removed at once (a read-only or
+  // special file system, or a directory without write permission, refused the output only after
+  // the run).
+  const std::string probe =
+      ((dir.empty() ? std::filesystem::path(".") : dir) / (".remesh-probe-" + std::to_string(::getpid()))).string();
   if (std::FILE* f = std::fopen(probe.c_str(), "wx")) {
     std::fclose(f);
     std::remove(probe.c_str());
@@ -93,6 +111,11 @@ void require_distinct_outputs(const std::vector<NamedOutput>& outputs) {
                        (*path == *earlier_path ? "" : " and " + *earlier_path));
     }
   }
+}
+
+void require_not_input(const std::string& in, const std::string& name, const std::optional<std::string>& path) {
+  if (path && same_file(in, *path))
+    throw UsageError(name + " names the input file " + in + ": writing it would replace the input mesh");
 }
 
 void print_repairs(std::ostream& out, const std::vector<Repair>& repairs) {

@@ -2,6 +2,7 @@
 /// `remesh`: the first argument picks the command (info, convert, dual, help); anything else is the
 /// remeshing command `remesh IN OUT --emin A --emax B ...`.
 
+#include <csignal>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
@@ -52,6 +53,10 @@ int dispatch(const std::string& command, const std::vector<std::string>& rest) {
 
 int run(int argc, char** argv) {
   using namespace remesh::cli;
+  // Output piped into a program that exits early (`remesh ... | head -1`) must not end the run before
+  // the mesh is written: without this SIGPIPE killed it (exit 141, no file). Writes to the closed
+  // pipe then fail quietly.
+  std::signal(SIGPIPE, SIG_IGN);
   std::vector<std::string> args(argv + 1, argv + argc);
   if (args.empty()) {
     std::cerr << kOverview;

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <cstdlib>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
@@ -146,6 +147,14 @@ TEST_CASE("bad arguments exit with 2 and one line on stderr", "[cli]") {
   cases.push_back({{mesh, out, "--emin", "0.2", "--emax", "0.3", "--stats", dir.file("no_such_dir/s.json")},
                    "--stats: output directory does not exist"});
   cases.push_back({{mesh, out, "--emin", "0.2", "--emax", "0.3", "--stats", dir.file("taken.obj")}, "--stats"});
+  // Numbers past the option's type say so (they read 'not a number' and 'outside -2147483648..').
+  cases.push_back({{mesh, out, "--emin", "1e-400", "--emax", "0.3"}, "--emin: 1e-400 is beyond the range"});
+  cases.push_back({{mesh, out, "--emin", "0.2", "--emax", "0.3", "--iterations", "5000000000"}, "far too large"});
+  cases.push_back({{mesh, out, "--emin", "0.2", "--emax", "0.3", "--rings", "99999999999999999999"}, "far too large"});
+  cases.push_back({{mesh, out, "--emin", "0.2", "--emax", "0.3", "--threads", "4097"}, "outside 0..1024"});
+  // A name longer than the file system takes (a long one it takes is written: the probe was
+  // named after it, and too long itself).
+  cases.push_back({{"convert", mesh, dir.file(std::string(300, 'a') + ".obj")}, "output file name too long"});
   for (const auto& c : cases) {
     std::string joined;
     for (const auto& a : c.args) joined += a + " ";
@@ -158,6 +167,9 @@ TEST_CASE("bad arguments exit with 2 and one line on stderr", "[cli]") {
   CHECK(!fs::exists(dir.file("out.obj")));
   for (const auto& entry : fs::directory_iterator(dir.path))
     CHECK(entry.path().filename().string().find("remesh-probe") == std::string::npos);  // no probe left behind
+  const std::string long_name = dir.file(std::string(240, 'a') + ".obj");
+  CHECK(remesh_cli({"convert", mesh, long_name}).exit_code == 0);
+  CHECK(fs::exists(long_name));
 }
 
 TEST_CASE("a bad input mesh exits with 3 and one line on stderr", "[cli]") {
@@ -180,6 +192,19 @@ TEST_CASE("a bad input mesh exits with 3 and one line on stderr", "[cli]") {
       CHECK(r.exit_code == 3);
       CHECK(lines(r.err) == 1);
     }
+  }
+  // A tetrahedron with two coincident corners reads as two triangles back to back: info describes
+  // it, remesh and dual refuse it (remesh aborted on an OpenMesh assertion).
+  const std::string pillow = dir.file("pillow.obj");
+  std::ofstream(pillow) << "v 1 1 0.5\nv 0 0 0\nv 0 0 0\nv 1 0 0\nf 1 3 2\nf 1 2 4\nf 2 3 4\nf 3 1 4\n";
+  CHECK(remesh_cli({"info", pillow}).exit_code == 0);
+  for (const std::vector<std::string>& args :
+       {std::vector<std::string>{pillow, dir.file("out.obj"), "--emin", "0.3", "--emax", "0.5"},
+        std::vector<std::string>{"dual", pillow, dir.file("out.obj")}}) {
+    const ProcessResult r = remesh_cli(args);
+    INFO("stderr: " << r.err);
+    CHECK(r.exit_code == 3);
+    CHECK(lines(r.err) == 1);
   }
   // A device that never ends is refused at once, not read forever.
   const ProcessResult r = remesh_cli({"info", "/dev/zero"});
@@ -506,7 +531,7 @@ TEST_CASE("remesh reports every bad option value at once, one line each", "[cli]
        {"--emin: 'abc' is not a number", "--emax: 'xyz' is not a number", "--rings: "}},
       // Not an integer, outside the parser's range, outside check()'s range.
       {{"--emin", "0.2", "--emax", "0.3", "--iterations", "1.5", "--threads", "99999", "--flip-factor", "2"},
-       {"--iterations: '1.5' is not an integer", "--threads: 99999 is outside 0..4096", "--flip-factor: "}},
+       {"--iterations: '1.5' is not an integer", "--threads: 99999 is outside 0..1024", "--flip-factor: "}},
   };
   for (const auto& c : cases) {
     std::vector<std::string> args = {mesh, out};
@@ -569,6 +594,14 @@ TEST_CASE("remesh refuses two outputs naming the same file before the run, and m
   CHECK(read_text(dual) == "earlier dual\n");
   CHECK(!fs::exists(dir.file("other.obj")));
 
+  // The dual over IN, whatever spelling: refused before anything is written (it replaced the input).
+  const std::string before = read_text(in);
+  refused({out, "--dual", (dir.path / "sub" / ".." / "sphere.obj").string()}, "--dual names the input file");
+  const ProcessResult dual_over_in = remesh_cli({"dual", in, (dir.path / "." / "sphere.obj").string()});
+  CHECK(dual_over_in.exit_code == 2);
+  CHECK(dual_over_in.err.find("OUT names the input file") != std::string::npos);
+  CHECK(read_text(in) == before);
+
   // OUT over IN stays allowed: IN is read before anything is written.
   const std::string both = dir.file("both.obj");
   fs::copy_file(in, both);
@@ -593,6 +626,18 @@ TEST_CASE("a job over --max-faces is refused with exit 3", "[cli]") {
   CHECK(r.exit_code == 3);
   CHECK(lines(r.err) == 1);
   CHECK(!fs::exists(dir.file("out.obj")));
+}
+
+TEST_CASE("output piped into a program that exits early does not stop the run", "[cli]") {
+  // `remesh ... | head -1`: SIGPIPE ended the run (exit 141) before the mesh was written.
+  TempDir dir;
+  write_obj(remesh::test::make_icosphere(3), dir.file("sphere.obj"));
+  const std::string out = dir.file("out.obj"), rc = dir.file("rc");
+  const std::string command = "( '" + std::string(REMESH_BIN) + "' '" + dir.file("sphere.obj") + "' '" + out +
+                              "' --emin 0.1 --emax 0.15 --iterations 10; echo $? > '" + rc + "' ) | head -c 1 > /dev/null";
+  REQUIRE(std::system(command.c_str()) == 0);
+  CHECK(read_text(rc) == "0\n");
+  CHECK(info_json(out).at("euler") == 2);
 }
 
 TEST_CASE("Ctrl-C stops the run and the partial mesh is still written", "[cli]") {
