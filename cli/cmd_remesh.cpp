@@ -3,12 +3,14 @@
 /// optionally the dual of the result projected onto IN, and the statistics rows as CSV or JSON.
 
 #include <algorithm>
+#include <cctype>
 #include <climits>
 #include <cstdio>
 #include <fstream>
 #include <iostream>
 #include <optional>
 #include <set>
+#include <string_view>
 
 #include "args.h"
 #include "commands.h"
@@ -24,6 +26,15 @@
 
 namespace remesh::cli {
 namespace {
+
+/// Does `path` end in `ext` (".csv"), in any case (OUT's extension is read so too)?
+bool ends_with_ignoring_case(const std::string& path, std::string_view ext) {
+  if (path.size() <= ext.size()) return false;
+  for (std::size_t k = 0; k < ext.size(); ++k)
+    if (std::tolower(static_cast<unsigned char>(path[path.size() - ext.size() + k])) != ext[k]) return false;
+  return true;
+}
+bool stats_as_json(const std::string& path) { return ends_with_ignoring_case(path, ".json"); }
 
 const std::vector<OptionSpec> kSpec = {
     {"emin", "A", "smallest allowed edge length, > 0 (required)"},
@@ -117,8 +128,7 @@ Job parse_job(const std::vector<std::string>& args) {
   if (p.relax_dual && !job.dual_out) throw UsageError("--relax-dual: relaxes the dual's bonds, so it needs --dual DUAL_OUT");
   if (job.stats_out) {
     const auto& s = *job.stats_out;
-    auto ends = [&](const char* ext) { return s.size() > 4 && s.compare(s.size() - 4, 4, ext) == 0; };
-    if (!ends(".csv") && !(s.size() > 5 && s.compare(s.size() - 5, 5, ".json") == 0))
+    if (!stats_as_json(s) && !ends_with_ignoring_case(s, ".csv"))
       throw UsageError("--stats: '" + s + "' must end in .csv or .json");
     try {
       require_writable(s);
@@ -262,7 +272,7 @@ int run_remesh(const std::vector<std::string>& args) {
     if (!job.quiet) dual_summary = dual_stats(dual, job.params.e_min, job.params.e_max);  // for the summary only
   }
   if (job.stats_out) {
-    const bool json = job.stats_out->size() > 5 && job.stats_out->ends_with(".json");
+    const bool json = stats_as_json(*job.stats_out);
     write_text_file(*job.stats_out, json ? nlohmann::json(rows).dump(2) + "\n" : stats_to_csv(rows));
   }
   if (!job.quiet) print_final(mesh, job, result, dual_summary, relaxed, input_crossings);

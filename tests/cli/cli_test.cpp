@@ -383,6 +383,11 @@ TEST_CASE("a short remesh run writes the mesh, the dual and one stats row per it
   REQUIRE(!stats.empty());
   CHECK(stats.size() <= 2);
   CHECK(stats.back().contains("max_projection_distance"));
+  // The extension in any case, as OUT's (.CSV was refused).
+  const ProcessResult upper = remesh_cli({dir.file("sphere.obj"), dir.file("OUT.OBJ"), "--emin", "0.1", "--emax", "0.15",
+                                          "--iterations", "2", "--quiet", "--stats", dir.file("S.JSON")});
+  CHECK(upper.exit_code == 0);
+  CHECK(nlohmann::json::parse(read_text(dir.file("S.JSON"))).is_array());
 }
 
 TEST_CASE("remesh --relax-dual puts more of the dual's bonds inside the bond interval, and needs --dual", "[cli]") {
