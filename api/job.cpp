@@ -71,13 +71,14 @@ JobRecord::StepSeconds step_seconds_from_json(const json& j) {
   return s;
 }
 
-/// {outside, in_thin_parts, limit, at_irregular_vertices, vertices: {limit, thinner: {vertices,
+/// {outside, in_thin_parts, limit, at_irregular_vertices, at_kept_creases, vertices: {limit, thinner: {vertices,
 /// regular}, thicker: {vertices, regular}, sampled}} (thin_parts.h).
 json thin_parts_to_json(const ThinParts& t) {
   return json{{"outside", t.outside},
               {"in_thin_parts", t.in_thin_parts},
               {"limit", t.limit},
               {"at_irregular_vertices", t.at_irregular},
+              {"at_kept_creases", t.at_creases},
               {"vertices",
                {{"limit", t.vertex_limit},
                 {"thinner", {{"vertices", t.vertices_thinner}, {"regular", t.regular_thinner}}},
@@ -244,6 +245,7 @@ JobRecord job_from_json(const json& j) {
                                  t->at("limit").get<double>()};
       // Absent in documents written before the counts existed: 0 there.
       job.thin_parts->at_irregular = t->value("at_irregular_vertices", std::size_t{0});
+      job.thin_parts->at_creases = t->value("at_kept_creases", std::size_t{0});
       if (const auto v = t->find("vertices"); v != t->end() && v->is_object()) {
         ThinParts& p = *job.thin_parts;
         p.vertex_limit = v->at("limit").get<double>();

@@ -169,6 +169,10 @@ void print_final(const TriMesh& mesh, const Job& job, const Result& result, cons
     std::printf("  irregular valence:    %zu of the %zu edges outside (an end of valence other than 6, or 4 on the "
                 "boundary: a 5-7 pair strains the edges around it by 10-15 %%, more than a tight interval allows)\n",
                 result.thin.at_irregular, result.thin.outside);
+  if (result.thin.outside > 0 && job.params.keep_creases)
+    std::printf("  at kept creases:      %zu of the %zu edges outside (an end on a crease --keep-creases holds: creases "
+                "or their corners closer together than the interval allows)\n",
+                result.thin.at_creases, result.thin.outside);
   if (result.layered)
     std::printf("  crossing faces:       not counted: the surface lies over itself throughout, as a part duplicated "
                 "in place or stacked shells do (not untangled)\n");

@@ -816,7 +816,7 @@ Result equalize(TriMesh& mesh, const Params& requested, const OnIteration& on_it
   mesh.update_normals();
   // Measured for the result only: a cancelled run has none (and its caller is waiting).
   if (result.outcome != Outcome::Cancelled)
-    result.thin = thin_parts(mesh, *reference, params.e_min, params.e_max, threads);
+    result.thin = thin_parts(mesh, *reference, params.e_min, params.e_max, threads, guard.get());
   // A run without the untangling (cleanup off, or stopped before it) counts them here; a cancelled
   // one leaves them unknown.
   if (!result.crossing_pairs && !result.layered && result.outcome != Outcome::Cancelled) {

@@ -43,7 +43,7 @@ bool thinner_than(const TriMesh& mesh, const ReferenceSurface& reference, OpenMe
 }
 
 ThinParts thin_parts(const TriMesh& mesh, const ReferenceSurface& reference, double e_min, double e_max,
-                     unsigned threads) {
+                     unsigned threads, const CreaseGuard* creases) {
   ThinParts out;
   out.limit = 2.0 * e_min / std::sqrt(3.0);
   std::vector<OpenMesh::EdgeHandle> outside;
@@ -57,6 +57,8 @@ ThinParts thin_parts(const TriMesh& mesh, const ReferenceSurface& reference, dou
   for (auto e : outside) {
     const auto h = mesh.halfedge_handle(e, 0);
     if (irregular(mesh.from_vertex_handle(h)) || irregular(mesh.to_vertex_handle(h))) ++out.at_irregular;
+    if (creases && (creases->on(mesh.point(mesh.from_vertex_handle(h))) || creases->on(mesh.point(mesh.to_vertex_handle(h)))))
+      ++out.at_creases;
   }
   std::atomic<std::size_t> thin{0};
   parallel_for(outside.size(), threads, [&](std::size_t i) {

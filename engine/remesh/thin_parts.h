@@ -12,6 +12,7 @@
 #include <cstddef>
 
 #include "core/mesh.h"
+#include "remesh/crease_lines.h"
 #include "remesh/reference_surface.h"
 
 namespace remesh {
@@ -25,6 +26,10 @@ struct ThinParts {
   /// on spot at [1.35, 1.65], 30 % of the edges at an irregular vertex were outside, 0.6 % of those
   /// two or more rings away), so in a tight interval these are the edges left outside.
   std::size_t at_irregular = 0;
+  /// Of the edges outside, those with an end on a crease that Params::keep_creases holds (0 without
+  /// it): where creases or their corners lie closer together than e_min, or a crease between two
+  /// corners fits no whole number of edges in the interval, the kept creases leave edges outside.
+  std::size_t at_creases = 0;
   /// Interior vertices by the reference's thickness where they lie (the distance from the vertex
   /// to the nearest reference triangle facing the other way, along the vertex normal): thinner
   /// than `vertex_limit` = 2 e_max, or not, and how many of each have valence 6. A tube a few
@@ -63,7 +68,8 @@ bool thinner_than(const TriMesh& mesh, const ReferenceSurface& reference, OpenMe
 /// Counts the edges of `mesh` outside [e_min, e_max], those of them in thin parts of `reference`
 /// (see the file comment) and those at irregular vertices, and the regular vertices by the
 /// reference's thickness (ThinParts::vertex_limit), on up to `threads` threads.
+/// With `creases` (the run's CreaseGuard under keep_creases), also the edges outside at them.
 ThinParts thin_parts(const TriMesh& mesh, const ReferenceSurface& reference, double e_min, double e_max,
-                     unsigned threads = 1);
+                     unsigned threads = 1, const CreaseGuard* creases = nullptr);
 
 }  // namespace remesh

@@ -78,6 +78,7 @@ TEST_CASE("job document: fields, links only when succeeded, round trip", "[api][
   r.iteration = 9;
   r.thin_parts = ThinParts{12, 7, 1.25};
   r.thin_parts->at_irregular = 5;
+  r.thin_parts->at_creases = 4;
   r.thin_parts->vertex_limit = 3.5;
   r.thin_parts->vertices_thinner = 40, r.thin_parts->regular_thinner = 31;
   r.thin_parts->vertices_thicker = 900, r.thin_parts->regular_thicker = 811;
@@ -113,6 +114,7 @@ TEST_CASE("job document: fields, links only when succeeded, round trip", "[api][
   CHECK(doc["thin_parts"]["in_thin_parts"] == 7);
   CHECK(doc["thin_parts"]["limit"] == 1.25);
   CHECK(doc["thin_parts"]["at_irregular_vertices"] == 5);
+  CHECK(doc["thin_parts"]["at_kept_creases"] == 4);
   CHECK(doc["thin_parts"]["vertices"] ==
         json{{"limit", 3.5}, {"thinner", {{"vertices", 40}, {"regular", 31}}},
              {"thicker", {{"vertices", 900}, {"regular", 811}}}, {"sampled", true}});
@@ -142,6 +144,7 @@ TEST_CASE("job document: fields, links only when succeeded, round trip", "[api][
   CHECK(back.thin_parts->in_thin_parts == 7);
   CHECK(back.thin_parts->limit == 1.25);
   CHECK(back.thin_parts->at_irregular == 5);
+  CHECK(back.thin_parts->at_creases == 4);
   CHECK(back.thin_parts->vertex_limit == 3.5);
   CHECK(back.thin_parts->vertices_thinner == 40);
   CHECK(back.thin_parts->regular_thinner == 31);
@@ -169,11 +172,13 @@ TEST_CASE("job document: fields, links only when succeeded, round trip", "[api][
     // A record written before the count existed reads with 0.
     json old = doc;
     old["thin_parts"].erase("at_irregular_vertices");
+    old["thin_parts"].erase("at_kept_creases");
     old["thin_parts"].erase("vertices");
     const JobRecord before = job_from_json(old);
     REQUIRE(before.thin_parts);
     CHECK(before.thin_parts->in_thin_parts == 7);
     CHECK(before.thin_parts->at_irregular == 0);
+    CHECK(before.thin_parts->at_creases == 0);
     CHECK(before.thin_parts->vertices_thinner == 0);
     CHECK(before.thin_parts->vertices_thicker == 0);
     CHECK_FALSE(before.thin_parts->sampled);

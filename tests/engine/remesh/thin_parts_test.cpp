@@ -10,6 +10,7 @@
 #include "remesh/equalize.h"
 #include "remesh/geometry.h"
 #include "remesh/reference_surface.h"
+#include "remesh/crease_lines.h"
 #include "remesh/thin_parts.h"
 #include "support/mesh_generators.h"
 
@@ -116,6 +117,36 @@ TEST_CASE("thin_parts counts the edges outside at vertices of valence other than
   const ThinParts none = thin_parts(sphere, ReferenceSurface(sphere), 0.01, 20.0, 2);
   CHECK(none.outside == 0);
   CHECK(none.at_irregular == 0);
+}
+
+TEST_CASE("thin_parts counts the edges outside at kept creases", "[thin]") {
+  // A box of 10 x 10 x 10 cells: its cells' diagonals (sqrt 2) are outside [0.9, 1.1], its grid
+  // edges (1) inside. With the crease guard, the diagonals with an end on one of the box's 12 edges
+  // (two coordinates at 0 or 10) count; without it, none.
+  const TriMesh box = test::make_box(10);
+  const CreaseLines lines(box);
+  REQUIRE(!lines.empty());
+  const CreaseGuard guard(lines, 1e-9);
+  const ReferenceSurface reference(box);
+  const ThinParts kept = thin_parts(box, reference, 0.9, 1.1, 2, &guard);
+  auto on_box_edge = [](const Vec3& p) {
+    int at_side = 0;
+    for (int k = 0; k < 3; ++k) at_side += p[k] == 0.0 || p[k] == 10.0;
+    return at_side >= 2;
+  };
+  std::size_t outside = 0, at_edge = 0;
+  for (auto e : box.edges()) {
+    const double l = box.calc_edge_length(e);
+    if (l >= 0.9 && l <= 1.1) continue;
+    ++outside;
+    const auto h = box.halfedge_handle(e, 0);
+    at_edge += on_box_edge(box.point(box.from_vertex_handle(h))) || on_box_edge(box.point(box.to_vertex_handle(h)));
+  }
+  CHECK(kept.outside == outside);
+  CHECK(at_edge > 0);
+  CHECK(at_edge < outside);
+  CHECK(kept.at_creases == at_edge);
+  CHECK(thin_parts(box, reference, 0.9, 1.1, 2).at_creases == 0);
 }
 
 TEST_CASE("thin_parts counts the regular vertices where the reference is thinner than 2 e_max and elsewhere",

@@ -256,7 +256,8 @@ export class JobView {
     const thin = job.thin_parts;
     if (thin && thin.outside > 0)
       text += ` · ${thin.outside} edges outside, ${thin.in_thin_parts} of them where the input is thinner than ${thin.limit.toPrecision(3)}` +
-        (thin.at_irregular_vertices !== undefined ? `, ${thin.at_irregular_vertices} at vertices of valence other than 6` : '');
+        (thin.at_irregular_vertices !== undefined ? `, ${thin.at_irregular_vertices} at vertices of valence other than 6` : '') +
+        (thin.at_kept_creases ? `, ${thin.at_kept_creases} at kept creases` : '');
     // Regular vertices where the input is thick and in its thin parts (a tube a few edges round
     // needs a 5-7 pair wherever it widens or narrows), when the result has both.
     const by = thin?.vertices;
