@@ -88,7 +88,7 @@ void store(ParsedParams& out, std::string_view name, const Value& v) {
 const char* kind_message(Kind k) {
   switch (k) {
     case Kind::Real: return "must be a finite number";
-    case Kind::Integer: return "must be an integer";
+    case Kind::Integer: return "must be an integer, at most 2147483647 in magnitude";
     case Kind::Boolean: return "must be true or false";
   }
   return "has a wrong type";

@@ -77,6 +77,10 @@ TEST_CASE("params_from_json: every bad field is reported", "[api][params]") {
     CHECK(fields_of(p.errors) == row.fields);
     for (const auto& e : p.errors) CHECK_FALSE(e.message.empty());
   }
+  // Too large for an integer says how large one may be ('must be an integer' alone misled).
+  const ParsedParams big = params_from_json(json::parse(R"({"emin":1,"emax":2,"iterations":99999999999})"));
+  REQUIRE(big.errors.size() == 1);
+  CHECK(big.errors[0].message.find("at most 2147483647") != std::string::npos);
 }
 
 TEST_CASE("params_from_query: strings parse strictly", "[api][params]") {
