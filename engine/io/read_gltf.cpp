@@ -132,7 +132,14 @@ class Collector {
   void node(int index, const Mat4& parent, int depth) {
     if (index < 0 || static_cast<std::size_t>(index) >= model_.nodes.size())
       fail("glTF: reference to missing node " + std::to_string(index));
-    if (depth > 64 || ++visits_ > 100000) fail("glTF: the node hierarchy is not a tree (cycle or too deep)");
+    if (depth > kMaxDepth)
+      fail("glTF: the node hierarchy is more than " + std::to_string(kMaxDepth) + " levels deep (or has a cycle)");
+    // A flat scene visits each node once; a hierarchy that shares subtrees may visit one node
+    // exponentially often (each level referencing the next twice): bounded here, and its
+    // triangles by max_triangles_. (A flat scene of over 100 000 nodes was refused as a cycle.)
+    if (++visits_ > std::max<std::size_t>(kMinVisits, 4 * model_.nodes.size()))
+      fail("glTF: the scene visits its nodes more than " + std::to_string(std::max<std::size_t>(kMinVisits, 4 * model_.nodes.size())) +
+           " times (subtrees shared too often)");
     const tinygltf::Node& n = model_.nodes[static_cast<std::size_t>(index)];
     const Mat4 m = multiply(parent, local_transform(n));
     if (n.mesh >= 0) mesh(n.mesh, m);
@@ -236,6 +243,8 @@ class Collector {
   const tinygltf::Model& model_;
   const ReadOptions& options_;
   RawSoup soup_;
+  static constexpr int kMaxDepth = 64;
+  static constexpr std::size_t kMinVisits = 100000;
   std::size_t visits_ = 0;
   std::size_t max_points_;
   std::size_t max_triangles_;  ///< what the scene may expand to (instancing)

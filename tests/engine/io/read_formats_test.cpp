@@ -474,6 +474,33 @@ TEST_CASE("glTF: a scene that instances its meshes into billions of triangles is
   CHECK_THROWS_WITH(read_as(gltf), Catch::Contains("expands to more than") && Catch::Contains("triangles"));
 }
 
+TEST_CASE("glTF node hierarchies: a flat scene of many nodes reads, a cycle and shared subtrees are refused") {
+  const std::string tri = R"("meshes":[{"primitives":[{"attributes":{"POSITION":0}}]}],
+    "accessors":[{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3","min":[0,0,0],"max":[1,1,0]}],
+    "bufferViews":[{"buffer":0,"byteLength":36}],
+    "buffers":[{"byteLength":36,"uri":"data:application/octet-stream;base64,AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAA"}]})";
+  auto scene = [&](const std::string& roots, const std::string& nodes) {
+    return R"({"asset":{"version":"2.0"},"scene":0,"scenes":[{"nodes":[)" + roots + R"(]}],"nodes":[)" + nodes + "]," + tri;
+  };
+  // 120 000 nodes side by side, each one triangle: read (it was refused as "not a tree").
+  std::string roots, nodes;
+  for (int n = 0; n < 120000; ++n) {
+    if (n > 0) roots += ',', nodes += ',';
+    roots += std::to_string(n);
+    nodes += R"({"mesh":0,"translation":[)";
+    nodes += std::to_string(2 * n);
+    nodes += ",0,0]}";
+  }
+  CHECK(read_as(scene(roots, nodes)).mesh.n_faces() == 120000);
+  // A node that is its own child.
+  CHECK_THROWS_WITH(read_as(scene("0", R"({"mesh":0,"children":[0]})")), Catch::Contains("or has a cycle"));
+  // 40 levels, each referencing the next twice: 2^40 visits of the last.
+  std::string chain;
+  for (int n = 0; n < 40; ++n) chain += "{\"children\":[" + std::to_string(n + 1) + "," + std::to_string(n + 1) + "]},";
+  chain += R"({"mesh":0})";
+  CHECK_THROWS_WITH(read_as(scene("0", chain)), Catch::Contains("visits its nodes more than"));
+}
+
 TEST_CASE("A file given under another format's name says what its content looks like") {
   const std::string ply = write_mesh(test::make_icosphere(0), Format::Ply);
   const std::string off = write_mesh(test::make_icosphere(0), Format::Off);
