@@ -10,7 +10,8 @@
 /// text formats add " (line N)"):
 ///   refused (MeshError): empty input; unknown format; malformed syntax ("OBJ line 12: bad vertex
 ///     coordinate 'x'"); counts that do not fit the file ("OFF header claims ... but only N bytes
-///     follow"); a text file cut inside its last line; non-finite coordinates ("vertex 7 (line 9)
+///     follow"); records an OFF or PLY file ends before ("OFF: file ends after 3 of 4 faces"; the
+///     last line of a text file needs no line break); non-finite coordinates ("vertex 7 (line 9)
 ///     has a non-finite coordinate (nan, 0, 1)"); faces with < 3 vertices ("face 4 (line 9) has 2
 ///     vertices; a face needs at least 3"); indices out of range ("face 1 (line 6) refers to vertex
 ///     8, but there are 4 vertices (0-based indices)"); edges with more than two faces

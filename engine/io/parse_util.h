@@ -43,14 +43,6 @@ class LineScanner {
   std::size_t line_ = 0;
 };
 
-/// True if text ends inside a line with content: no line break after its last non-blank byte.
-/// Text meshes end with a line break; a missing one means the file was most likely cut short.
-inline bool ends_mid_line(std::string_view text) {
-  std::size_t n = text.size();
-  while (n > 0 && (text[n - 1] == ' ' || text[n - 1] == '\t')) --n;
-  return n > 0 && text[n - 1] != '\n' && text[n - 1] != '\r';
-}
-
 inline bool is_space(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\f' || c == '\v'; }
 
 /// Cuts the next whitespace-separated token off the front of `s`; false if none is left.

@@ -58,9 +58,6 @@ RawSoup read_obj(std::string_view bytes, const ReadOptions& options) {
   while (lines.next(line)) {
     std::string_view rest = line, tok;
     if (!next_token(rest, tok)) continue;
-    if ((tok == "v" || tok == "f") && lines.remaining() == 0 && ends_mid_line(bytes))
-      fail_at(lines.line_number(), "the file ends inside this '" + std::string(tok) +
-                                       "' line, without a line break (truncated?)");
     if (tok == "v") {
       parse_vertex(rest, lines.line_number(), soup);
     } else if (tok == "f" || tok == "fo") {

@@ -107,7 +107,7 @@ RawSoup read_off_binary(std::string_view bytes, std::size_t data_start, const Re
 
 /// The vertex and face records of an ASCII OFF file, from the content line after `lines` (the line
 /// of the counts, or of the edge count), nv and nf of them.
-RawSoup read_records(std::string_view bytes, LineScanner lines, std::int64_t nv, std::int64_t nf) {
+RawSoup read_records(LineScanner lines, std::int64_t nv, std::int64_t nf) {
   Tokens tokens(lines, {});
   std::string_view tok;
   // The first record continued on another line: a hint for the end-of-file messages, since a value
@@ -161,8 +161,6 @@ RawSoup read_records(std::string_view bytes, LineScanner lines, std::int64_t nv,
     soup.offsets.push_back(static_cast<std::uint32_t>(soup.indices.size()));
     soup.face_lines.push_back(static_cast<std::uint32_t>(ln));
   }
-  if (lines.remaining() == 0 && ends_mid_line(bytes))
-    fail_at(lines.line_number(), "the file ends inside the last line, without a line break (truncated?)");
   return soup;
 }
 
@@ -203,18 +201,18 @@ RawSoup read_off(std::string_view bytes, const ReadOptions& options) {
     if (next_content_line(ahead, next) && next_token(next, first) && !next_token(next, extra) &&
         parse_int(first, edges)) {
       try {
-        return read_records(bytes, ahead, nv, nf);
+        return read_records(ahead, nv, nf);
       } catch (const MeshError&) {
         const std::exception_ptr spec_error = std::current_exception();
         try {
-          return read_records(bytes, lines, nv, nf);
+          return read_records(lines, nv, nf);
         } catch (const MeshError&) {
           std::rethrow_exception(spec_error);
         }
       }
     }
   }
-  return read_records(bytes, lines, nv, nf);
+  return read_records(lines, nv, nf);
 }
 
 }  // namespace remesh::io

@@ -192,11 +192,6 @@ class BodyReader {
   std::size_t remaining() const { return h_.encoding == Encoding::Ascii ? text_.size() - pos_ : bin_.remaining(); }
   std::size_t line() const { return line_; }
   bool ascii() const { return h_.encoding == Encoding::Ascii; }
-  /// Ascii: nothing but whitespace is left.
-  bool at_end() {
-    skip_space();
-    return pos_ >= text_.size();
-  }
 
   /// One scalar of type t; `what` names it for errors.
   double scalar(Type t, const Where& where) {
@@ -312,8 +307,6 @@ RawSoup read_ply(std::string_view bytes, const ReadOptions& options) {
       if (is_vertex) soup.points.emplace_back(xyz[0], xyz[1], xyz[2]);
     }
   }
-  if (!binary && body.at_end() && ends_mid_line(bytes))
-    fail("PLY line " + std::to_string(body.line()) + ": the file ends inside the last line, without a line break (truncated?)");
   return soup;
 }
 

@@ -440,18 +440,39 @@ TEST_CASE("Malformed text names the line") {
                     Contains("PLY header line 4") && Contains("flot"));
 }
 
-TEST_CASE("Text files cut inside their last line are refused as truncated") {
-  // Cutting "f 1 2 3" or "3 0 1 2" inside a number leaves a well-formed but wrong face: refuse.
-  CHECK_THROWS_WITH(read(kTetraVerts + "f 1 3 2\nf 1 2 4\nf 2 3 4\nf 1 4"), Contains("OBJ line 8") && Contains("truncated"));
-  CHECK_THROWS_WITH(read(kTetraVerts + "f 1 3 2\nf 1 2 4\nf 2 3 4\nf 1 4 3"), Contains("truncated"));
-  CHECK_NOTHROW(read(kTetraVerts + kTetraFaces + "# trailing comment without a line break"));
-  CHECK_THROWS_WITH(read("OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2"), Contains("OFF line 6") && Contains("truncated"));
-  CHECK_NOTHROW(read("OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n"));
-  const std::string ply = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
-                          "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n"
-                          "0 0 0\n1 0 0\n0 1 0\n3 0 1 2";
-  CHECK_THROWS_WITH(read(ply), Contains("PLY line 13") && Contains("truncated"));
-  CHECK_NOTHROW(read(ply + "\n"));
+TEST_CASE("A text file's last line needs no line break, and OFF and PLY cut short are refused by their counts") {
+  // Files joined with '\n' between lines end without one; every other mesh tool reads them.
+  const std::string obj = kTetraVerts + kTetraFaces;
+  const std::string off = "OFF\n4 4 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 1 2 3\n3 0 3 2\n";
+  const std::string ply = "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\n"
+                          "property float z\nelement face 4\nproperty list uchar int vertex_indices\nend_header\n"
+                          "0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 1 2 3\n3 0 3 2\n";
+  for (const std::string& text : {obj, off, ply}) {
+    const LoadedMesh want = read(text);
+    REQUIRE(want.mesh.n_faces() == 4);
+    for (const std::string end : {"", "\r", " \t"}) {
+      const std::string unended = text.substr(0, text.size() - 1) + end;
+      CAPTURE(unended);
+      const LoadedMesh got = read(unended);
+      REQUIRE(got.mesh.n_vertices() == want.mesh.n_vertices());
+      REQUIRE(got.mesh.n_faces() == want.mesh.n_faces());
+      for (auto v : want.mesh.vertices()) CHECK(got.mesh.point(v) == want.mesh.point(v));
+      for (auto f : want.mesh.faces()) {
+        std::vector<int> a, b;
+        for (auto v : got.mesh.fv_range(f)) a.push_back(v.idx());
+        for (auto v : want.mesh.fv_range(f)) b.push_back(v.idx());
+        CHECK(a == b);
+      }
+    }
+  }
+  CHECK_NOTHROW(read(obj + "# trailing comment without a line break"));
+  // OFF and PLY declare their counts: a file cut inside or before its last record is refused.
+  CHECK_THROWS_WITH(read(off.substr(0, off.size() - 3)),
+                    Contains("OFF line 10") && Contains("declares 3 vertices but the file ends after 2"));
+  CHECK_THROWS_WITH(read(off.substr(0, off.size() - 8)), Contains("file ends after 3 of 4 faces"));
+  CHECK_THROWS_WITH(read(ply.substr(0, ply.size() - 3)), Contains("PLY line 17: bad list length 3 in face 3"));
+  // OBJ declares none: a cut that leaves a face of 2 corners is refused as such.
+  CHECK_THROWS_WITH(read(obj.substr(0, obj.size() - 3)), Contains("face 3 (line 8) has 2 vertices"));
   CHECK_THROWS_WITH(read("solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\n"
                          "endloop\nendfacet\n"),
                     Contains("endsolid"));
