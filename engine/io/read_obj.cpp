@@ -1,6 +1,7 @@
 /// \file read_obj.cpp
 /// Wavefront OBJ: `v` and `f` lines (v, v/vt, v//vn, v/vt/vn, negative indices); everything else
-/// (vt, vn, g, o, s, usemtl, mtllib, l, comments) is skipped. CRLF is fine.
+/// (vt, vn, g, o, s, usemtl, mtllib, l) is skipped, as is a comment from '#' on any line. CRLF is
+/// fine.
 
 #include <string>
 
@@ -56,7 +57,7 @@ RawSoup read_obj(std::string_view bytes, const ReadOptions& options) {
   LineScanner lines(bytes);
   std::string_view line;
   while (lines.next(line)) {
-    std::string_view rest = line, tok;
+    std::string_view rest = line.substr(0, line.find('#')), tok;  // a comment may end any line
     if (!next_token(rest, tok)) continue;
     if (tok == "v") {
       parse_vertex(rest, lines.line_number(), soup);

@@ -98,6 +98,18 @@ TEST_CASE("OBJ: index forms, negative indices, groups, CRLF and quads") {
   CHECK(test::check_loaded(m.mesh).empty());
 }
 
+TEST_CASE("OBJ: a comment from '#' may end any line, a face's too") {
+  // Every line of the cube with a comment, after blanks or right after its last value.
+  std::string commented;
+  std::size_t n = 0;
+  for (std::size_t at = 0, end; (end = kCubeObj.find("\r\n", at)) != std::string::npos; at = end + 2)
+    commented += kCubeObj.substr(at, end - at) + (++n % 2 ? "   # c 1 2\r\n" : "#c\r\n");
+  REQUIRE(n == 26);
+  check_same_mesh(read_as(commented), read_as(kCubeObj));
+  const std::string tetra = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2 # c\nf 1 2 4\t#\nf 2 3 4#4\nf 1 4 3 #\n";
+  CHECK(read_as(tetra).mesh.n_faces() == 4);
+}
+
 TEST_CASE("OBJ: a concave polygon is ear-clipped, not fanned across the outside") {
   // An L-shaped hexagon: a fan from vertex 0 would create a triangle outside the polygon.
   const std::string obj =
