@@ -9,7 +9,8 @@
 /// Validation and repair, in this order (element indices in messages are 0-based, in file order;
 /// text formats add " (line N)"):
 ///   refused (MeshError): empty input; unknown format; malformed syntax ("OBJ line 12: bad vertex
-///     coordinate 'x'"); counts that do not fit the file ("OFF header claims ... but only N bytes
+///     coordinate 'x'"); numbers past the largest double ("... '1e400' (too large: ...)"; one
+///     nearer 0 than any double reads as the nearest, 0 or a denormal); counts that do not fit the file ("OFF header claims ... but only N bytes
 ///     follow"); records an OFF or PLY file ends before ("OFF: file ends after 3 of 4 faces"; the
 ///     last line of a text file needs no line break); non-finite coordinates ("vertex 7 (line 9)
 ///     has a non-finite coordinate (nan, 0, 1)"); faces with < 3 vertices ("face 4 (line 9) has 2

@@ -2,6 +2,7 @@
 /// \file parse_util.h
 /// Internal: bounds-checked scanning of text lines and binary fields, shared by the readers.
 
+#include <algorithm>
 #include <bit>
 #include <charconv>
 #include <cmath>
@@ -60,17 +61,51 @@ inline bool next_token(std::string_view& s, std::string_view& token) {
   return true;
 }
 
-/// Parses a whole token as a double (accepts a leading '+', "nan", "inf"); false if malformed.
+/// For a number from_chars() parsed whole but found out of range: true if its magnitude is above
+/// the largest double, false if below the smallest. The decimal exponent of its first significant
+/// digit decides: out of range, it is above 300 or below -300. `t` has no leading '+'.
+inline bool overflows(std::string_view t) {
+  if (!t.empty() && t[0] == '-') t.remove_prefix(1);
+  const std::size_t e = std::min(t.find_first_of("eE"), t.size());
+  const std::string_view digits = t.substr(0, e);
+  const std::size_t point = std::min(digits.find('.'), digits.size());
+  const std::size_t first = digits.find_first_not_of("0.");
+  if (first == std::string_view::npos) return false;  // zero: never out of range
+  long long exponent = first < point ? static_cast<long long>(point - first - 1)
+                                     : -static_cast<long long>(first - point);
+  long long written = 0;  // the exponent after 'e', saturated: its digits may be many
+  std::size_t i = e + 1;
+  const bool negative = i < t.size() && t[i] == '-';
+  if (i < t.size() && (t[i] == '-' || t[i] == '+')) ++i;
+  for (; i < t.size(); ++i) written = std::min(written * 10 + (t[i] - '0'), 1'000'000'000LL);
+  exponent += negative ? -written : written;
+  return exponent > 0;
+}
+
+/// Parses a whole token as a double (accepts a leading '+', "nan", "inf"); false if malformed or
+/// beyond the largest double (about 1.8e308: too_large_note() says so). A number closer to 0 than
+/// any double reads as the nearest one, as strtod() gives: a denormal, or 0 with its sign.
 inline bool parse_double(std::string_view t, double& v) {
   if (!t.empty() && t[0] == '+') t.remove_prefix(1);
   if (t.empty()) return false;
   auto [p, ec] = std::from_chars(t.data(), t.data() + t.size(), v);
-  if (ec == std::errc::result_out_of_range) {
-    // Out-of-range literals: treat as infinite/zero, let the finiteness check name them.
-    v = (t[0] == '-') ? -HUGE_VAL : HUGE_VAL;
-    return p == t.data() + t.size();
+  if (p != t.data() + t.size()) return false;
+  // from_chars() returns denormals itself and reports out of range what rounds to 0 or infinity.
+  if (ec == std::errc::result_out_of_range && !overflows(t)) {
+    v = t[0] == '-' ? -0.0 : 0.0;
+    return true;
   }
-  return ec == std::errc() && p == t.data() + t.size();
+  return ec == std::errc();
+}
+
+/// For the message of a token parse_double() refused: " (too large: ...)" if it is a number beyond
+/// the largest double, else "".
+inline std::string too_large_note(std::string_view t) {
+  if (!t.empty() && t[0] == '+') t.remove_prefix(1);
+  double v = 0;
+  auto [p, ec] = std::from_chars(t.data(), t.data() + t.size(), v);
+  if (p != t.data() + t.size() || ec != std::errc::result_out_of_range || !overflows(t)) return "";
+  return " (too large: the largest double is about 1.8e308)";
 }
 
 /// Parses a whole token as a signed integer; false if malformed or out of int64 range.

@@ -22,7 +22,7 @@ void parse_vertex(std::string_view rest, std::size_t line, RawSoup& soup) {
   for (double& v : c) {
     // No index: OBJ counts vertices from 1, the other messages from 0; the line says which.
     if (!next_token(rest, tok)) fail_at(line, "a vertex with fewer than 3 coordinates");
-    if (!parse_double(tok, v)) fail_at(line, "bad vertex coordinate " + quote(tok));
+    if (!parse_double(tok, v)) fail_at(line, "bad vertex coordinate " + quote(tok) + too_large_note(tok));
   }
   soup.points.emplace_back(c[0], c[1], c[2]);
   soup.point_lines.push_back(static_cast<std::uint32_t>(line));

@@ -131,7 +131,8 @@ RawSoup read_records(LineScanner lines, std::int64_t nv, std::int64_t nf) {
         fail_at(ln, "vertex " + std::to_string(i) + " has fewer than 3 coordinates (the file ends after " +
                         std::to_string(k) + ")");
       if (!parse_double(tok, c[k]))
-        fail_at(tokens.line(), "bad coordinate " + quote(tok) + " of vertex " + std::to_string(i));
+        fail_at(tokens.line(), "bad coordinate " + quote(tok) + " of vertex " + std::to_string(i) +
+                                    too_large_note(tok));
     }
     if (wrapped.empty() && tokens.line() != ln)
       wrapped = "vertex " + std::to_string(i) + " at line " + std::to_string(ln);

@@ -201,7 +201,9 @@ class BodyReader {
     }
     std::string_view tok = token(where);
     double v = 0;
-    if (!parse_double(tok, v)) fail("PLY line " + std::to_string(line_) + ": bad number " + quote(tok) + " in " + where.str());
+    if (!parse_double(tok, v))
+      fail("PLY line " + std::to_string(line_) + ": bad number " + quote(tok) + " in " + where.str() +
+           too_large_note(tok));
     return v;
   }
   /// Line of the next ascii token (after skipping whitespace), for locations.

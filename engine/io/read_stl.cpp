@@ -102,7 +102,7 @@ RawSoup read_ascii_stl(std::string_view bytes, const ReadOptions& options) {
       double c[3];
       for (double& v : c) {
         if (!next_token(rest, tok)) fail_at(ln, "vertex has fewer than 3 coordinates");
-        if (!parse_double(tok, v)) fail_at(ln, "bad vertex coordinate " + quote(tok));
+        if (!parse_double(tok, v)) fail_at(ln, "bad vertex coordinate " + quote(tok) + too_large_note(tok));
       }
       soup.indices.push_back(welder.add(Vec3(c[0], c[1], c[2]), static_cast<std::uint32_t>(ln)));
       ++corners;

@@ -1,11 +1,13 @@
 // Validation and repair: each malformed case gives its specific, located error or counted repair.
 #include <catch2/catch.hpp>
 
+#include <cmath>
 #include <cstdint>
 #include <limits>
 #include <random>
 
 #include "io/mesh_io.h"
+#include "io/parse_util.h"
 #include "io/summary.h"
 #include "io_test_util.h"
 #include "support/mesh_generators.h"
@@ -108,9 +110,71 @@ TEST_CASE("Non-finite coordinates are refused with the vertex index and line") {
                     Contains("vertex 1 (line 2)") && Contains("non-finite"));
   CHECK_THROWS_WITH(read("OFF\n3 1 0\n0 0 0\n1 0 0\n0 inf 0\n3 0 1 2\n"),
                     Contains("vertex 2 (line 5)") && Contains("non-finite"));
-  CHECK_THROWS_WITH(read("v 0 0 0\nv 1e999 0 0\nv 0 1 0\nf 1 2 3\n"), Contains("vertex 1 (line 2)"));
   // glTF: the coordinate as stored, before the node transform spreads the NaN ("(nan, nan, nan)").
   CHECK_THROWS_WITH(read_mesh(tetra_glb(12, 4)), Contains("POSITION element 1 has a non-finite coordinate (1, nan, 0)"));
+}
+
+TEST_CASE("Numbers nearer 0 than any double read as the nearest one, numbers past the largest are refused") {
+  // A tetrahedron in each text format, its corner (1, y, 0) with y as written.
+  auto tetra = [](const std::string& y) {
+    const std::string p[4] = {"0 0 0", "1 " + y + " 0", "0 1 0", "0 0 1"};
+    const int faces[4][3] = {{0, 2, 1}, {0, 1, 3}, {1, 2, 3}, {0, 3, 2}};
+    std::string obj, off = "OFF\n4 4 0\n", ply, stl = "solid t\n";
+    ply = "ply\nformat ascii 1.0\nelement vertex 4\nproperty double x\nproperty double y\nproperty double z\n"
+          "element face 4\nproperty list uchar int vertex_indices\nend_header\n";
+    for (const std::string& q : p) {
+      obj += "v " + q + "\n";
+      off += q + "\n";
+      ply += q + "\n";
+    }
+    const std::string records = "3 0 2 1\n3 0 1 3\n3 1 2 3\n3 0 3 2\n";  // kTetraFaces from 0
+    for (const auto& f : faces) {
+      stl += "facet normal 0 0 0\nouter loop\n";
+      for (int k : f) stl += "vertex " + p[k] + "\n";
+      stl += "endloop\nendfacet\n";
+    }
+    return std::vector<std::string>{obj + kTetraFaces, off + records, ply + records, stl + "endsolid t\n"};
+  };
+  const double tiny = std::numeric_limits<double>::denorm_min();
+  const std::pair<const char*, double> underflows[] = {
+      {"1e-330", 0.0}, {"-1e-330", -0.0}, {"0.0001e-321", 0.0}, {"123456789e-340", 0.0},
+      {"2.4703282292062327e-324", 0.0},  // just under half the smallest denormal
+      {"2.4703282292062328e-324", tiny}, {"1e-310", 1e-310}, {"-4e-324", -tiny}};
+  for (const auto& [text, want] : underflows)
+    for (const std::string& file : tetra(text)) {
+      CAPTURE(file);
+      const LoadedMesh m = read(file);
+      REQUIRE(m.mesh.n_faces() == 4);
+      int found = 0;
+      for (auto v : m.mesh.vertices()) {
+        const Vec3 q = m.mesh.point(v);
+        if (q[0] != 1) continue;
+        ++found;
+        CHECK(q[1] == want);
+        CHECK(std::signbit(q[1]) == std::signbit(want));
+      }
+      CHECK(found == 1);
+    }
+  for (const char* text : {"1e400", "-1e400", "1.7976931348623159e308", "100e307"})
+    for (const std::string& file : tetra(text))
+      CHECK_THROWS_WITH(read(file), Contains(std::string("'") + text + "'") && Contains(" line ") &&
+                                        Contains("(too large: the largest double is about 1.8e308)"));
+  // "inf" is no number out of range: non-finite, as before.
+  CHECK_THROWS_WITH(read(tetra("inf")[0]),
+                    Contains("vertex 1 (line 2) has a non-finite coordinate (1, inf, 0)"));
+  // At the edge of the range, the parsing the readers share: the largest double, as written and
+  // written above it where it still rounds down to it, reads; just past that is too large.
+  const double largest = std::numeric_limits<double>::max();
+  for (const char* text :
+       {"1.7976931348623157e308", "1.7976931348623158e308", "+0.0017976931348623157e311"}) {
+    double v = 0;
+    CHECK(io::parse_double(text, v));
+    CHECK(v == largest);
+  }
+  double v = 0;
+  CHECK(!io::parse_double("-1.7976931348623159e308", v));
+  CHECK(io::too_large_note("-1.7976931348623159e308") != "");
+  for (const char* text : {"1e-400", "inf", "abc", "1e400x", "1e"}) CHECK(io::too_large_note(text) == "");
 }
 
 TEST_CASE("Face indices out of range are refused with the face and line") {
