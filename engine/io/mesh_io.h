@@ -94,8 +94,8 @@ PolygonSoup to_soup(const PolyMesh& mesh);
 /// Serialises to bytes. Polygons: OBJ/OFF/PLY keep them; STL fan-triangulates; GLB writes a
 /// triangle-fan primitive plus a LINES primitive of the true polygon edges; XYZ writes one atom
 /// ("C x y z") per point; Lammps writes a LAMMPS data file (atom_style bond): one carbon atom per
-/// point and one bond per edge of the faces, in a box 5 % wider than their bounding box. Gltf is
-/// written as GLB. XYZ and Lammps are written, not read. Throws std::invalid_argument for unsupported.
+/// point and one bond per edge of the faces (no Bonds section without edges), in a box 5 % wider
+/// than their bounding box. Gltf is written as GLB. XYZ and Lammps are written, not read. Throws std::invalid_argument for unsupported.
 std::string write_mesh(const PolygonSoup& soup, Format format);
 std::string write_mesh(const TriMesh& mesh, Format format);
 std::string write_mesh(const PolyMesh& mesh, Format format);

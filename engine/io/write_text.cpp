@@ -130,7 +130,9 @@ std::string write_lammps(const PolygonSoup& soup) {
     out += " 1 1";  // molecule 1, atom type 1
     append_point(out, soup.points[i]);
   }
-  out += "\nBonds\n\n";
+  // read_data refuses a Bonds section when the header counts none ("Invalid data file section").
+  // The bond type stays declared: a script's bond_coeff 1 works for every file written here.
+  if (!bonds.empty()) out += "\nBonds\n\n";
   for (std::size_t i = 0; i < bonds.size(); ++i) {
     append_uint(out, i + 1);
     out += " 1 ";  // bond type 1
