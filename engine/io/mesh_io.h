@@ -95,11 +95,14 @@ PolygonSoup to_soup(const PolyMesh& mesh);
 /// triangle-fan primitive plus a LINES primitive of the true polygon edges; XYZ writes one atom
 /// ("C x y z") per point; Lammps writes a LAMMPS data file (atom_style bond): one carbon atom per
 /// point and one bond per edge of the faces (no Bonds section without edges), in a box 5 % wider
-/// than their bounding box. Gltf is written as GLB. XYZ and Lammps are written, not read. Throws std::invalid_argument for unsupported.
+/// than their bounding box. Gltf is written as GLB. XYZ and Lammps are written, not read. Throws
+/// std::invalid_argument for unsupported; std::range_error for STL and GLB, which store float32,
+/// when a point has a coordinate of about 3.4e38 or more in magnitude (nothing is written).
 std::string write_mesh(const PolygonSoup& soup, Format format);
 std::string write_mesh(const TriMesh& mesh, Format format);
 std::string write_mesh(const PolyMesh& mesh, Format format);
-/// Writes to a file, format from the extension. Throws MeshError if unknown, std::runtime_error on I/O.
+/// Writes to a file, format from the extension. Throws MeshError if unknown, std::range_error as
+/// write_mesh() before creating the file, std::runtime_error on I/O.
 void write_mesh_file(const PolygonSoup& soup, const std::string& path);
 
 /// The MIME type served for a format (model/obj, model/gltf-binary, ...).

@@ -2,12 +2,31 @@
 /// Binary writers: PLY (little endian, double coordinates, polygon faces) and STL (float32,
 /// fan-triangulated, normals computed).
 
+#include <cmath>
 #include <cstring>
+#include <stdexcept>
 
 #include "io/parse_util.h"
 #include "io/writers.h"
 
 namespace remesh::io {
+
+void check_float32(const PolygonSoup& soup, const char* format) {
+  // Below this, a double rounds to at most FLT_MAX; from it (ties to even) to infinity.
+  constexpr double rounds_to_inf = 0x1.ffffffp+127;
+  for (std::size_t i = 0; i < soup.points.size(); ++i) {
+    const Vec3& p = soup.points[i];
+    if (std::abs(p[0]) < rounds_to_inf && std::abs(p[1]) < rounds_to_inf && std::abs(p[2]) < rounds_to_inf)
+      continue;
+    std::string at = "(";
+    for (int k = 0; k < 3; ++k) {
+      append_number(at, p[k]);
+      at += k < 2 ? ", " : ")";
+    }
+    throw std::range_error(std::string(format) + " cannot hold point " + std::to_string(i) + " " + at +
+                           ": it stores coordinates as float32, at most about 3.4e38 in magnitude");
+  }
+}
 
 std::string write_ply(const PolygonSoup& soup) {
   const std::size_t faces = soup.offsets.size() - 1;
@@ -32,6 +51,7 @@ std::string write_ply(const PolygonSoup& soup) {
 }
 
 std::string write_stl(const PolygonSoup& soup) {
+  check_float32(soup, "STL");
   std::uint32_t count = 0;
   for_each_fan_triangle(soup, [&](std::uint32_t, std::uint32_t, std::uint32_t) { ++count; });
   std::string out(80, ' ');

@@ -43,6 +43,7 @@ std::string number(double v) {
 }  // namespace
 
 std::string write_glb(const PolygonSoup& soup) {
+  check_float32(soup, "GLB");
   std::vector<std::uint32_t> tris;
   for_each_fan_triangle(soup, [&](std::uint32_t a, std::uint32_t b, std::uint32_t c) { tris.insert(tris.end(), {a, b, c}); });
   bool polygons = false;

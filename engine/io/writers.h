@@ -19,6 +19,10 @@ std::string write_glb(const PolygonSoup& soup);  ///< triangles (+ LINES of poly
 /// Appends the shortest decimal text that reads back as exactly v.
 void append_number(std::string& out, double v);
 
+/// Throws std::range_error, naming `format` and the first such point, if a coordinate does not
+/// round to a finite float32 (magnitude about 3.4e38 or more): STL and GLB store float32.
+void check_float32(const PolygonSoup& soup, const char* format);
+
 /// Fan triangles of every face: (f0, fi, fi+1).
 template <class F>
 void for_each_fan_triangle(const PolygonSoup& soup, F&& f) {

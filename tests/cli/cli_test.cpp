@@ -298,6 +298,27 @@ TEST_CASE("convert round trips obj -> ply/off/stl/glb -> obj keep the counts", "
   }
 }
 
+TEST_CASE("convert refuses coordinates STL and GLB cannot hold: exit 1, one line, nothing written", "[cli]") {
+  TempDir dir;
+  // A tetrahedron with corners at 1e308: it reads (doubles), but float32 ends near 3.4e38.
+  std::ofstream(dir.file("far.obj")) << "v 0 0 0\nv 1e308 0 0\nv 0 1e308 0\nv 0 0 1e308\n"
+                                        "f 1 3 2\nf 1 2 4\nf 2 3 4\nf 1 4 3\n";
+  for (const char* name : {"far.stl", "far.glb"}) {
+    const ProcessResult r = remesh_cli({"convert", dir.file("far.obj"), dir.file(name)});
+    INFO(name << "\nstderr: " << r.err);
+    CHECK(r.exit_code == 1);
+    CHECK(lines(r.err) == 1);
+    CHECK(r.err.find("remesh: error: ") == 0);
+    CHECK(r.err.find("point 1 (1e+308, 0, 0)") != std::string::npos);
+    CHECK(r.err.find("float32, at most about 3.4e38") != std::string::npos);
+    CHECK(!fs::exists(dir.file(name)));
+  }
+  // The double formats hold it.
+  const ProcessResult r = remesh_cli({"convert", dir.file("far.obj"), dir.file("far.ply")});
+  INFO(r.err);
+  CHECK(r.exit_code == 0);
+}
+
 TEST_CASE("dual writes one polygon per interior vertex", "[cli]") {
   TempDir dir;
   const TriMesh grid = remesh::test::make_hex_lattice_patch(7, 8, 1.0);

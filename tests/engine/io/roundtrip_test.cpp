@@ -3,11 +3,14 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <limits>
 #include <set>
 #include <sstream>
+#include <stdexcept>
 
 #include "io/mesh_io.h"
 #include "io/summary.h"
@@ -84,6 +87,49 @@ TEST_CASE("Exact positions survive text formats, including awkward doubles") {
     LoadedMesh back = read_mesh(write_mesh(m, f));
     for (int i = 0; i < 3; ++i) CHECK(back.mesh.point(TriMesh::VertexHandle(i)) == m.point(TriMesh::VertexHandle(i)));
   }
+}
+
+TEST_CASE("STL and GLB refuse coordinates float32 cannot hold, before writing anything") {
+  // A tetrahedron 1e38 across with its apex at (0, 0, z); with `loose`, a point in no face there
+  // (refused too: a mesh's vertices are all written, used or not).
+  auto tetra = [](double z, double loose = 0) {
+    std::vector<Vec3> points = {{0, 0, 0}, {1e38, 0, 0}, {0, 1e38, 0}, {0, 0, z}};
+    if (loose != 0) points.emplace_back(0, 0, loose);
+    return test::make_soup(points, {{0, 2, 1}, {0, 1, 3}, {1, 2, 3}, {0, 3, 2}});
+  };
+  const double largest = std::numeric_limits<float>::max();
+  const double rounds_to_inf = largest + std::ldexp(1.0, 103);  // half float32's spacing there
+  const auto dir =
+      std::filesystem::temp_directory_path() / ("remesh_io_float32_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  for (const auto& [f, name] : {std::pair{Format::Stl, "STL"}, {Format::Glb, "GLB"}}) {
+    INFO(name);
+    CHECK_THROWS_WITH(write_mesh(tetra(1e308), f),
+                      std::string(name) + " cannot hold point 3 (0, 0, 1e+308): it stores coordinates as "
+                                          "float32, at most about 3.4e38 in magnitude");
+    CHECK_THROWS_WITH(write_mesh(tetra(1, -1e308), f),
+                      Catch::StartsWith(std::string(name) + " cannot hold point 4 (0, 0, -1e+308)"));
+    for (double z : {-1e39, rounds_to_inf, std::numeric_limits<double>::infinity()}) {
+      CAPTURE(z);
+      CHECK_THROWS_AS(write_mesh(tetra(z), f), std::range_error);
+    }
+    const std::string path = (dir / ("t." + std::string(format_name(f)))).string();
+    CHECK_THROWS_AS(write_mesh_file(tetra(1e308), path), std::range_error);
+    CHECK(!std::filesystem::exists(path));
+    // Written as before: what rounds to float32's largest, as that.
+    for (double z : {largest, std::nextafter(rounds_to_inf, 0.0)}) {
+      CAPTURE(z);
+      const LoadedMesh back = read_mesh(write_mesh(tetra(z), f));
+      double top = 0;
+      for (auto v : back.mesh.vertices()) top = std::max(top, back.mesh.point(v)[2]);
+      CHECK(top == largest);
+    }
+  }
+  // The double formats hold it.
+  for (Format f : {Format::Obj, Format::Off})
+    CHECK(write_mesh(tetra(1e308), f).find(" 1e+308\n") != std::string::npos);
+  CHECK_NOTHROW(write_mesh(tetra(1e308), Format::Ply));
+  std::filesystem::remove_all(dir);
 }
 
 TEST_CASE("Polygon soups keep their polygons in OBJ, OFF and PLY, GLB adds a LINES primitive") {
