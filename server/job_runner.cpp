@@ -44,8 +44,21 @@ RunOutput run_job(const remesh::api::JobRecord& job, std::string upload, unsigne
   if (out.result.outcome == remesh::Outcome::Cancelled) return out;
 
   collect_garbage(mesh);
-  for (const std::string& f : remesh::api::remeshed_formats())
-    write("remeshed." + f, remesh::write_mesh(mesh, format_of(f)));
+  // A format that cannot hold the result (STL and GLB store float32: a mesh placed beyond 3.4e38)
+  // is not written; a download of it makes it then, and is refused saying why. The job succeeds
+  // with the others.
+  auto write_each = [&](const std::string& stem, const auto& m, const std::vector<std::string>& formats) {
+    for (const std::string& f : formats) {
+      std::string bytes;
+      try {
+        bytes = remesh::write_mesh(m, format_of(f));
+      } catch (const std::range_error&) {
+        continue;
+      }
+      write(stem + "." + f, bytes);
+    }
+  };
+  write_each("remeshed", mesh, remesh::api::remeshed_formats());
   const remesh::ReferenceSurface reference = [&] {
     remesh::TriMesh input_mesh;
     input.rebuild(input_mesh);
@@ -61,8 +74,7 @@ RunOutput run_job(const remesh::api::JobRecord& job, std::string upload, unsigne
     }
   }
   out.dual = remesh::dual_stats(dual, params.e_min, params.e_max);
-  for (const std::string& f : remesh::api::dual_formats())
-    write("dual." + f, remesh::write_mesh(dual, format_of(f)));
+  write_each("dual", dual, remesh::api::dual_formats());
   return out;
 }
 

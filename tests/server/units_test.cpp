@@ -207,6 +207,22 @@ TEST_CASE("run_job hands each result file to the sink once, and none when cancel
   CHECK(static_cast<long>(back.mesh.n_vertices()) - static_cast<long>(back.mesh.n_edges()) +
             static_cast<long>(back.mesh.n_faces()) == 2);
 
+  // The same sphere placed 1e39 from the origin: STL and GLB (float32) cannot hold it and are not
+  // written; the job's other files are (the run failed while writing them).
+  {
+    remesh::TriMesh far = sphere;
+    for (auto v : far.vertices()) far.point(v) += remesh::Vec3(1e39, 0, 0);
+    remesh::api::JobRecord far_job = job;
+    std::set<std::string> written;
+    const RunOutput far_out = run_job(far_job, remesh::write_mesh(far, remesh::Format::Off), 1, {}, std::stop_token{},
+                                      [&](const std::string& name, std::string_view) { written.insert(name); });
+    CHECK(far_out.result.outcome != remesh::Outcome::Cancelled);
+    std::set<std::string> without_float32;
+    for (const std::string& name : expected)
+      if (!name.ends_with(".stl") && !name.ends_with(".glb")) without_float32.insert(name);
+    CHECK(written == without_float32);
+  }
+
   std::stop_source stopped;
   stopped.request_stop();
   std::size_t calls = 0;
