@@ -2,6 +2,7 @@
 #include <catch2/catch.hpp>
 
 #include <array>
+#include <cctype>
 #include <vector>
 
 #include "io/mesh_io.h"
@@ -332,6 +333,16 @@ TEST_CASE("STL: ASCII, binary, and binary whose header starts with 'solid'") {
   CHECK(a.format == Format::Stl);
   CHECK(a.mesh.n_vertices() == 42);  // welded by position, not reported as a repair
   CHECK(a.repairs.empty());
+  // Keywords in upper case, as some exporters write them (read as a binary file of 1.3 billion
+  // triangles), with the format told and found from the content.
+  std::string upper = test::write_stl_ascii(soup);
+  for (char& c : upper) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+  CHECK(detect_format(upper) == Format::Stl);
+  for (const std::optional<Format> f : {std::optional<Format>(Format::Stl), std::optional<Format>()}) {
+    const LoadedMesh u = read_as(upper, f);
+    CHECK(u.mesh.n_vertices() == 42);
+    CHECK(u.mesh.n_faces() == 80);
+  }
 
   std::string bin = write_mesh(soup, Format::Stl);
   bin.replace(0, 12, "solid trick ");
