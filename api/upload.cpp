@@ -70,7 +70,7 @@ std::string utf8_prefix(std::string_view text, std::size_t max_bytes) {
     // no overlong forms, no surrogates, nothing past U+10FFFF).
     std::size_t n = 0;
     unsigned char lo = 0x80, hi = 0xBF;
-    if (b < 0x80) n = 1;
+    if (b < 0x80) n = b < 0x20 || b == 0x7F ? 0 : 1;  // control characters (NUL, CR, LF, ...) too
     else if (b >= 0xC2 && b <= 0xDF) n = 2;
     else if (b >= 0xE0 && b <= 0xEF) n = 3, lo = b == 0xE0 ? 0xA0 : 0x80, hi = b == 0xED ? 0x9F : 0xBF;
     else if (b >= 0xF0 && b <= 0xF4) n = 4, lo = b == 0xF0 ? 0x90 : 0x80, hi = b == 0xF4 ? 0x8F : 0xBF;

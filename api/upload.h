@@ -37,7 +37,8 @@ std::string content_disposition(std::string_view disposition, std::string_view f
 
 /// `text` as valid UTF-8 of at most `max_bytes` bytes: each byte that does not begin a valid
 /// sequence becomes U+FFFD, and the text is cut between characters (a job's filename is shown and
-/// stored as JSON, which must be UTF-8: "%FF.obj" used to give a 500).
+/// stored as JSON, which must be UTF-8: "%FF.obj" used to give a 500). ASCII control characters
+/// (NUL, CR, LF, ...; a filename had them, then its download's filename* too) become U+FFFD as well.
 std::string utf8_prefix(std::string_view text, std::size_t max_bytes);
 
 /// Limits of the service (0 = none).

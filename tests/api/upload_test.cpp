@@ -185,4 +185,8 @@ TEST_CASE("prepare_job keeps a filename that is not UTF-8 as valid UTF-8", "[api
   const PreparedJob job = prepare_job(sphere_obj(), "\xFF\xFEmesh.obj", Format::Obj, good_params(), {});
   CHECK(job.record.filename == "\xEF\xBF\xBD\xEF\xBF\xBDmesh.obj");
   CHECK_NOTHROW(job_to_json(job.record, "/api/v1", 0).dump());
+  // Control characters too (the filename kept NUL, CR and LF).
+  const PreparedJob controls =
+      prepare_job(sphere_obj(), std::string("a\0b\r\nc\x7F.obj", 11), Format::Obj, good_params(), {});
+  CHECK(controls.record.filename == "a\xEF\xBF\xBD" "b\xEF\xBF\xBD\xEF\xBF\xBD" "c\xEF\xBF\xBD.obj");
 }
