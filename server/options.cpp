@@ -62,9 +62,9 @@ const std::vector<Spec>& specs() {
          if (o.max_upload_mb < 1 || o.max_upload_mb > 1'048'576)
            throw std::invalid_argument("--max-upload-mb: " + v + " is not 1 to 1048576 (MiB)");
        }},
-      {"max-faces", "N", "largest input mesh in faces (default 2000000)",
+      {"max-faces", "N", "largest input mesh in faces (default 2000000; 0 = no limit)",
        [](Options& o, const std::string& v) { o.max_faces = to_size("max-faces", v); }},
-      {"max-output-faces", "N", "largest estimated result in faces (default 5000000)",
+      {"max-output-faces", "N", "largest estimated result in faces (default 5000000; 0 = no limit)",
        [](Options& o, const std::string& v) { o.max_output_faces = to_size("max-output-faces", v); }},
       {"max-iterations", "N", "largest iterations parameter (default 1000)",
        [](Options& o, const std::string& v) {
@@ -78,8 +78,12 @@ const std::vector<Spec>& specs() {
          if (!(o.max_job_seconds >= 0 && o.max_job_seconds <= 1e7))
            throw std::invalid_argument("--max-job-seconds: " + v + " is not 0 to 10000000");
        }},
-      {"queue-size", "N", "queued jobs accepted before 503 (default 64)",
-       [](Options& o, const std::string& v) { o.queue_size = to_size("queue-size", v); }},
+      {"queue-size", "N", "queued jobs accepted before 503 (default 64, at least 1)",
+       [](Options& o, const std::string& v) {
+         // 0 started a service that answered every job 503 'queue is full (0 jobs)'.
+         o.queue_size = to_size("queue-size", v);
+         if (o.queue_size < 1) throw std::invalid_argument("--queue-size: must be at least 1 (a job waits there for a worker)");
+       }},
       {"job-ttl-hours", "H", "finished jobs are deleted after H hours (default 168; 0 = never)",
        [](Options& o, const std::string& v) { o.job_ttl_hours = to_double("job-ttl-hours", v); }},
       {"data-cap-mb", "N", "size cap of the data directory in MiB, oldest finished jobs go first (default 10240; 0 = none)",

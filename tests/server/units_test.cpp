@@ -80,6 +80,8 @@ TEST_CASE("options: defaults, command line, environment, errors", "[server][opti
                                                          // MiB counts whose bytes wrap round 2^64
                                                          {"--max-upload-mb", "17592186044416"},
                                                          {"--max-upload-mb", "0"},
+                                                         // a queue that takes no job (every POST was a 503)
+                                                         {"--queue-size", "0"},
                                                          {"--data-cap-mb", "17592186044416"}}) {
     auto r = Args(bad).parse();
     CHECK_FALSE(r.options);
