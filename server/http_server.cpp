@@ -9,6 +9,7 @@
 #include <cmath>
 #include <chrono>
 #include <regex>
+#include <string_view>
 #include <utility>
 
 #include "api/json_codec.h"
@@ -158,6 +159,29 @@ json parse_noting_repeats(const std::string& text, std::vector<std::string>& rep
   return parsed;
 }
 
+/// The query of a request target ("/path?a=1&b=x%3Dy"), each pair split at its first '=' and
+/// percent-decoded ('+' as a space), in order, repeats kept. cpp-httplib 0.11 splits a pair at every
+/// '=' and keeps the last piece as the value: "emin=0.1=0.12" was emin 0.12, a base64 token's
+/// padding ("access_token=dG9rZW4=") was lost (401), "filename=my=file.obj" became "file.obj".
+httplib::Params parse_query(const std::string& target) {
+  httplib::Params params;
+  const std::size_t question = target.find('?');
+  if (question == std::string::npos) return params;
+  const std::string_view query = std::string_view(target).substr(question + 1);
+  for (std::size_t begin = 0; begin <= query.size();) {
+    const std::size_t end = std::min(query.find('&', begin), query.size());
+    const std::string_view pair = query.substr(begin, end - begin);
+    begin = end + 1;
+    const std::size_t eq = pair.find('=');
+    const std::string_view key = pair.substr(0, eq);
+    if (key.empty()) continue;  // "&&" or "=x": no name (cpp-httplib drops them too)
+    const std::string_view value = eq == std::string_view::npos ? std::string_view() : pair.substr(eq + 1);
+    params.emplace(httplib::detail::decode_url(std::string(key), true),
+                   httplib::detail::decode_url(std::string(value), true));
+  }
+  return params;
+}
+
 /// Query parameters as a map (first value of each), minus the ones that are not job parameters.
 std::map<std::string, std::string> query_params(const httplib::Request& req) {
   std::map<std::string, std::string> out;
@@ -293,6 +317,9 @@ void HttpServer::Impl::setup() {
     t_request_start = std::chrono::steady_clock::now();
     t_problem = {};
     t_answer_size = 0;
+    // The query as sent, before anything reads a parameter (the token included). The request object
+    // is httplib's own, not const; only its parsed parameters are replaced.
+    const_cast<httplib::Request&>(req).params = parse_query(req.target);
     // Both framings: RFC 9112 6.3 has a server refuse the message and close the connection (a
     // proxy in front may have read it the other way: the shape of request smuggling).
     if (req.has_header("Content-Length") && req.has_header("Transfer-Encoding")) {

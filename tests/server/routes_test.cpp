@@ -770,3 +770,38 @@ TEST_CASE("remeshd: the bearer scheme is matched without regard to case", "[serv
     CHECK(r->status == 401);
   }
 }
+
+TEST_CASE("remeshd: a query value is split from its key at the first '=' only", "[server]") {
+  // cpp-httplib 0.11 kept the text after a value's last '=': emin=0.1=0.12 ran with emin 0.12, a
+  // base64 token's padding was lost (401), a file name lost what came before its '='.
+  TempDir tmp;
+  Daemon d(tmp.path / "data", {"--workers", "1", "--token", "dG9rZW4="});
+  auto anon = d.client();
+  for (const std::string token : {"dG9rZW4=", "dG9rZW4%3D"}) {
+    CAPTURE(token);
+    auto r = anon.Get(("/api/v1/jobs?access_token=" + token).c_str());
+    REQUIRE(r);
+    CHECK(r->status == 200);
+  }
+  CHECK(anon.Get("/api/v1/jobs?access_token=dG9rZW4")->status == 401);
+  auto c = d.client("dG9rZW4=");
+  auto twice = submit_raw(c, sphere_obj(1), "emin=0.1=0.12&emax=0.5");
+  REQUIRE(twice);
+  CHECK(twice->status == 422);
+  CHECK(error_fields(twice) == std::set<std::string>{"emin"});
+  auto named = submit_raw(c, sphere_obj(1), "emin=0.3&emax=0.5&iterations=1&filename=my=file.obj");
+  REQUIRE(named);
+  INFO(named->body);
+  REQUIRE(named->status == 202);
+  CHECK(body_of(named)["input"]["filename"] == "my=file.obj");
+  // A pair without '=' is a key with an empty value; empty pairs are skipped.
+  auto list = c.Get("/api/v1/jobs?&limit=1&&state=");
+  REQUIRE(list);
+  CHECK(list->status == 200);
+  CHECK(body_of(list)["limit"] == 1);
+  // A key given twice is refused with the same value too (cpp-httplib dropped an identical pair).
+  auto same = c.Get("/api/v1/jobs?limit=1&limit=1");
+  REQUIRE(same);
+  CHECK(same->status == 422);
+  CHECK(error_fields(same) == std::set<std::string>{"limit"});
+}
