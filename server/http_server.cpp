@@ -77,6 +77,10 @@ constexpr std::size_t kDrainBytes = 64 * kMiB;
 constexpr double kLeftCheckSeconds = 1.0;
 
 thread_local std::chrono::steady_clock::time_point t_request_start;
+/// Did the pre-routing handler see this thread's current request? cpp-httplib 0.11 answers a request
+/// line or header it cannot parse, a URI too long and a Range it cannot parse before routing: the
+/// error handler is then the first to see the request. Cleared when the request is logged.
+thread_local bool t_pre_routed = false;
 
 double seconds_since(std::chrono::steady_clock::time_point t) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
@@ -315,6 +319,7 @@ void HttpServer::Impl::setup() {
 
   server.set_pre_routing_handler([this](const httplib::Request& req, httplib::Response& res) {
     t_request_start = std::chrono::steady_clock::now();
+    t_pre_routed = true;
     t_problem = {};
     t_answer_size = 0;
     // The query as sent, before anything reads a parameter (the token included). The request object
@@ -392,6 +397,9 @@ void HttpServer::Impl::setup() {
   });
   server.set_error_handler(httplib::Server::HandlerWithResponse([](const httplib::Request& req,
                                                                    httplib::Response& res) {
+    // Answered before routing: timed from here (it was timed from this thread's previous request,
+    // hours for an idle thread).
+    if (!t_pre_routed) t_request_start = std::chrono::steady_clock::now();
     if (!res.body.empty() || res.content_length_ > 0) return httplib::Server::HandlerResponse::Unhandled;
     std::string detail;
     switch (res.status) {
@@ -425,6 +433,7 @@ void HttpServer::Impl::setup() {
   });
   server.set_logger([this](const httplib::Request& req, const httplib::Response& res) {
     double secs = seconds_since(t_request_start);
+    t_pre_routed = false;
     std::string route = route_label(req);
     metrics.observe_request(req.method, route, res.status, secs);
     log.info("request", {str("method", req.method), str("path", req.path), str("route", route),

@@ -27,11 +27,20 @@ std::string esc(const std::string& s) {
   return out;
 }
 
+/// The method as a label: the methods a client of this service may send, else "other". A label of
+/// whatever name a request carried made a series of each: 3000 requests with random 7000-character
+/// methods (each a 400) grew /metrics from 23 KB to 21.5 MB, held for the process's life.
+const char* method_label(const std::string& method) {
+  for (const char* known : {"GET", "HEAD", "POST", "PUT", "DELETE", "OPTIONS", "PATCH"})
+    if (method == known) return known;
+  return "other";
+}
+
 }  // namespace
 
 void Metrics::observe_request(const std::string& method, const std::string& route, int status, double seconds) {
   std::lock_guard lock(mutex_);
-  ++requests_[{method, route, status}];
+  ++requests_[{method_label(method), route, status}];
   Histogram& h = latency_[route];
   for (std::size_t i = 0; i < kBuckets.size(); ++i)
     if (seconds <= kBuckets[i]) ++h.buckets[i];

@@ -23,7 +23,8 @@ struct Gauges {
 
 class Metrics {
  public:
-  /// Records one finished HTTP request. `route` is the pattern ("/api/v1/jobs/{id}").
+  /// Records one finished HTTP request. `route` is the pattern ("/api/v1/jobs/{id}"); a method
+  /// other than GET, HEAD, POST, PUT, DELETE, OPTIONS and PATCH is counted as "other".
   void observe_request(const std::string& method, const std::string& route, int status, double seconds);
   /// Counts one remesh iteration (any job).
   void count_iteration();
