@@ -332,6 +332,18 @@ void HttpServer::Impl::setup() {
       send_problem(res, 400, "malformed request: both Content-Length and Transfer-Encoding are set");
       return httplib::Server::HandlerResponse::Handled;
     }
+    // Content-Length more than once with different values: the body's end is unknown (RFC 9110 8.6,
+    // RFC 9112 6.3: 400, and close the connection). cpp-httplib 0.11 took the first and a proxy in
+    // front may take the last. The same value repeated is one length (RFC 9110 8.6 allows it).
+    for (std::size_t i = 1; i < req.get_header_value_count("Content-Length"); ++i) {
+      const std::string first = req.get_header_value("Content-Length");
+      const std::string other = req.get_header_value("Content-Length", i);
+      if (other == first) continue;
+      res.set_header("Connection", "close");
+      send_problem(res, 400, "malformed request: Content-Length is given more than once with different values ('" +
+                                 first.substr(0, 20) + "', '" + other.substr(0, 20) + "')");
+      return httplib::Server::HandlerResponse::Handled;
+    }
     // cpp-httplib 0.11 limits each header line (8 KiB) but not their number; the whole block has
     // been read by now, so this bounds what the request costs from here on, and says why.
     if (const std::size_t bytes = header_bytes(req); bytes > kMaxHeaderBytes) {

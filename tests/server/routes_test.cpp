@@ -743,6 +743,24 @@ TEST_CASE("remeshd: requests a black-box review found answered wrongly", "[serve
   CHECK(smuggled.rfind("HTTP/1.1 400", 0) == 0);
   CHECK(smuggled.find("both Content-Length and Transfer-Encoding") != std::string::npos);
   CHECK(smuggled.find("HTTP/1.1 200") == std::string::npos);  // the second request is not served
+  // Content-Length twice with different values: 400, and the connection is closed (RFC 9110 8.6,
+  // RFC 9112 6.3); cpp-httplib took the first. The same value twice is one length.
+  for (const std::string& path : {std::string("/api/v1/jobs?emin=1&emax=2"), std::string("/api/v1/nope")}) {
+    const std::string conflicting = raw_exchange(
+        d.port(), "POST " + path + " HTTP/1.1\r\nHost: x\r\nContent-Length: 3\r\nContent-Length: 10\r\n\r\n" +
+                      "0123456789GET /healthz HTTP/1.1\r\nHost: x\r\n\r\n", 10);
+    INFO(conflicting);
+    CHECK(conflicting.rfind("HTTP/1.1 400", 0) == 0);
+    CHECK(conflicting.find("\r\nConnection: close\r\n") != std::string::npos);
+    CHECK(conflicting.find("application/problem+json") != std::string::npos);
+    CHECK(conflicting.find("Content-Length is given more than once with different values ('3', '10')") !=
+          std::string::npos);
+    CHECK(conflicting.find("HTTP/1.1 200") == std::string::npos);
+  }
+  const std::string repeated = raw_exchange(
+      d.port(), "GET /healthz HTTP/1.1\r\nHost: x\r\nContent-Length: 0\r\nContent-Length: 0\r\nConnection: close\r\n\r\n",
+      10);
+  CHECK(repeated.rfind("HTTP/1.1 200", 0) == 0);
 
   // Headers of more than 64 KiB in all (each line under httplib's 8 KiB): 431, and the daemon serves on.
   std::string flood = "GET /healthz HTTP/1.1\r\nHost: x\r\n";
