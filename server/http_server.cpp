@@ -111,6 +111,25 @@ void send_problem(httplib::Response& res, int status, const std::string& detail,
   send_problem(res, make_problem(status, detail, errors));
 }
 
+/// Ends the connection once this answer is written. cpp-httplib 0.11 sends a handler's
+/// "Connection: close" (beside its own "Keep-Alive") but keeps the connection and reads the next
+/// request from it: a request sent after a refused body (Content-Length twice, or with
+/// Transfer-Encoding: a smuggled request) was served. It ends a connection when writing an answer
+/// fails, so the body goes out through a content provider that writes it whole and then reports
+/// failure. For the post-routing handler: the headers, Content-Length included, are final by then,
+/// and so is the body, cut to the range asked for (httplib would cut the provider's bytes again).
+void close_after(const httplib::Request& req, httplib::Response& res) {
+  const_cast<httplib::Request&>(req).ranges.clear();
+  res.headers.erase("Keep-Alive");
+  auto body = std::make_shared<std::string>(std::move(res.body));
+  res.body.clear();
+  res.content_length_ = body->size();
+  res.content_provider_ = [body](std::size_t offset, std::size_t length, httplib::DataSink& sink) {
+    if (offset < body->size()) sink.write(body->data() + offset, std::min(length, body->size() - offset));
+    return false;  // all written: the connection ends here
+  };
+}
+
 /// Does the request carry a body? Without Content-Length and Transfer-Encoding it has none (RFC
 /// 9112 6.3), and cpp-httplib 0.11's reader would wait for one until the client closed or the
 /// read timed out (30 s).
@@ -406,6 +425,10 @@ void HttpServer::Impl::setup() {
     }
     cors_headers(res);
     res.set_header("X-Content-Type-Options", "nosniff");
+    // (A client that says "Connection: close" has its connection closed by httplib.)
+    if (res.get_header_value("Connection") == "close" && req.get_header_value("Connection") != "close" &&
+        !res.content_provider_)
+      close_after(req, res);
   });
   server.set_error_handler(httplib::Server::HandlerWithResponse([](const httplib::Request& req,
                                                                    httplib::Response& res) {

@@ -197,6 +197,10 @@ SseStream read_events(int port, const std::string& path, const httplib::Headers&
 }
 
 std::string raw_exchange(int port, const std::string& request, double timeout) {
+  return raw_exchange(port, std::vector<std::string>{request}, 0, timeout);
+}
+
+std::string raw_exchange(int port, const std::vector<std::string>& parts, double pause, double timeout) {
   const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
   if (fd < 0) throw std::runtime_error("socket() failed");
   timeval tv{};
@@ -208,8 +212,12 @@ std::string raw_exchange(int port, const std::string& request, double timeout) {
   addr.sin_port = htons(static_cast<std::uint16_t>(port));
   addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
   std::string answer;
-  if (::connect(fd, reinterpret_cast<sockaddr*>(&addr), sizeof addr) == 0 &&
-      ::send(fd, request.data(), request.size(), MSG_NOSIGNAL) == static_cast<ssize_t>(request.size())) {
+  bool sent = ::connect(fd, reinterpret_cast<sockaddr*>(&addr), sizeof addr) == 0;
+  for (std::size_t i = 0; sent && i < parts.size(); ++i) {
+    if (i > 0) std::this_thread::sleep_for(std::chrono::duration<double>(pause));
+    sent = ::send(fd, parts[i].data(), parts[i].size(), MSG_NOSIGNAL) == static_cast<ssize_t>(parts[i].size());
+  }
+  if (sent) {
     char buffer[4096];
     for (ssize_t n; (n = ::recv(fd, buffer, sizeof buffer, 0)) > 0;) answer.append(buffer, static_cast<std::size_t>(n));
   }

@@ -79,6 +79,8 @@ SseStream read_events(int port, const std::string& path, const httplib::Headers&
 /// Sends `request` (raw bytes: a request line, headers, maybe a body) to 127.0.0.1:`port` and
 /// returns what the server answers until it closes or sends nothing for `timeout` seconds.
 std::string raw_exchange(int port, const std::string& request, double timeout);
+/// The same with the request sent in parts, `pause` seconds apart (each part its own segment).
+std::string raw_exchange(int port, const std::vector<std::string>& parts, double pause, double timeout);
 
 /// Files (recursively) under a directory.
 std::size_t count_files(const std::filesystem::path& dir);

@@ -2,6 +2,7 @@
 #include <catch2/catch.hpp>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -756,6 +757,22 @@ TEST_CASE("remeshd: requests a black-box review found answered wrongly", "[serve
     CHECK(conflicting.find("Content-Length is given more than once with different values ('3', '10')") !=
           std::string::npos);
     CHECK(conflicting.find("HTTP/1.1 200") == std::string::npos);
+  }
+  // ... also when the next request comes in a segment of its own, after the answer: cpp-httplib
+  // sent "Connection: close" but read on, and served it. The connection ends at once (not after
+  // the 5 s keep-alive), for both framings refused.
+  for (const std::string& framing : {std::string("Content-Length: 3\r\nContent-Length: 40"),
+                                     std::string("Content-Length: 40\r\nTransfer-Encoding: chunked")}) {
+    CAPTURE(framing);
+    const auto t0 = std::chrono::steady_clock::now();
+    const std::string later = raw_exchange(
+        d.port(), {"POST /api/v1/nope HTTP/1.1\r\nHost: x\r\n" + framing + "\r\n\r\n", "GET /healthz HTTP/1.1\r\nHost: x\r\n\r\n"},
+        0.5, 10);
+    INFO(later);
+    CHECK(later.rfind("HTTP/1.1 400", 0) == 0);
+    CHECK(later.find("HTTP/1.1 200") == std::string::npos);
+    CHECK(later.find("Keep-Alive") == std::string::npos);
+    CHECK(std::chrono::steady_clock::now() - t0 < std::chrono::seconds(3));
   }
   const std::string repeated = raw_exchange(
       d.port(), "GET /healthz HTTP/1.1\r\nHost: x\r\nContent-Length: 0\r\nContent-Length: 0\r\nConnection: close\r\n\r\n",
