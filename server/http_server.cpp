@@ -31,23 +31,22 @@ using remesh::api::make_problem;
 
 namespace {
 
-/// The size of the bytes this thread last answered with send_bytes (0: none since the request began),
-/// for the Content-Range of a 416 (RFC 9110 15.5.17: "bytes */size").
-thread_local std::size_t t_answer_size = 0;
+/// The byte range the current request of this thread asks for (RFC 9110 14), taken out of
+/// httplib's request by the pre-routing handler (as httplib parses it: -1 for a position not given;
+/// kMalformed for a Range it could not parse): cpp-httplib 0.11 cut every answer to the ranges
+/// asked for (an error's, an event stream's too), gave the range's end unclamped in Content-Range
+/// ("bytes 242000-250000/242231" with 231 bytes), and a 416 without the length. Handlers that honour
+/// ranges answer through send_ranged; every other answer is whole. Set for a GET (or HEAD) asking
+/// for one range: several get the whole answer, a 200 (RFC 9110 14.2 lets a server ignore Range;
+/// httplib built the multipart answer to all of them in memory: "bytes=0-,0-,..." made a 2 GB
+/// answer of a 1 MB result).
+thread_local std::optional<httplib::Range> t_range;
+constexpr httplib::Range kMalformed{-1, -1};  ///< as httplib reads "bytes=-": never satisfiable
 
-/// A file's bytes as the answer, from a content provider: httplib 0.11.4 brotli-compresses every
+/// `bytes` as the answer, from a content provider: httplib 0.11.4 brotli-compresses every
 /// set_content() body at its slowest setting when the client accepts br (browsers always do):
-/// seconds for three.js or a big OBJ; a content provider is never compressed. But a request for
-/// byte ranges gets them as a body: httplib cuts a body's ranges itself (416 past its end) before
-/// the post-routing handler, while a provider's ranges it serves as asked, unclipped ("bytes=0-300000"
-/// of a 10 KB file sent 300 001 bytes, most from the heap past the file). Such a range of a text
-/// file may then be compressed (the range of the uncompressed bytes, br-encoded).
-void send_bytes(const httplib::Request& req, httplib::Response& res, std::string bytes, const std::string& mime) {
-  t_answer_size = bytes.size();
-  if (!req.ranges.empty()) {
-    res.set_content(std::move(bytes), mime);
-    return;
-  }
+/// seconds for three.js or a big OBJ; a content provider is never compressed.
+void provide(httplib::Response& res, std::string bytes, const std::string& mime) {
   auto data = std::make_shared<std::string>(std::move(bytes));
   const std::size_t size = data->size();
   res.set_content_provider(size, mime,
@@ -86,29 +85,73 @@ double seconds_since(std::chrono::steady_clock::time_point t) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
 }
 
+std::string dump(const json& body) { return body.dump(-1, ' ', false, json::error_handler_t::replace); }
+
 void send_json(httplib::Response& res, int status, const json& body) {
   res.status = status;
-  res.set_content(body.dump(-1, ' ', false, json::error_handler_t::replace), "application/json");
+  res.set_content(dump(body), "application/json");
 }
-
-/// The problem document this thread last answered, whole: cpp-httplib 0.11 cuts a request's byte
-/// ranges out of every answer, an error's too ("Range: bytes=0-5" on a 404 gave `{"deta`); the
-/// post-routing handler puts it back. Reset when a request is routed.
-struct LastProblem {
-  int status = 0;
-  std::string body;
-};
-thread_local LastProblem t_problem;
 
 void send_problem(httplib::Response& res, const Problem& p) {
   res.status = p.status;
-  t_problem = {p.status, p.body.dump(-1, ' ', false, json::error_handler_t::replace)};
-  res.set_content(t_problem.body, "application/problem+json");
+  res.set_content(dump(p.body), "application/problem+json");
 }
 
 void send_problem(httplib::Response& res, int status, const std::string& detail,
                   const std::vector<FieldError>& errors = {}) {
   send_problem(res, make_problem(status, detail, errors));
+}
+
+std::string range_problem(const httplib::Request& req) {
+  return "the Range header '" + req.get_header_value("Range") + "' is malformed or starts past the end of " +
+         req.path;
+}
+
+/// A 416 for a range of an answer of `size` bytes: the problem, and the length (RFC 9110 15.5.17).
+void send_unsatisfiable(const httplib::Request& req, httplib::Response& res, std::size_t size) {
+  send_problem(res, 416, range_problem(req));
+  res.set_header("Content-Range", "bytes */" + std::to_string(size));
+}
+
+/// `bytes` as a 200, or the range of them the request asks for (t_range): a 206 with Content-Range
+/// "bytes first-last/size", the last byte clamped to the size; a 416 with "bytes */size" when it
+/// starts past the end, asks for the last 0 bytes or is malformed. A range goes out uncompressed (Content-Range
+/// counts the bytes as they are); a whole answer as set_content() if `compress`, else provided.
+void send_ranged(const httplib::Request& req, httplib::Response& res, std::string bytes, const std::string& mime,
+                 bool compress) {
+  const std::size_t size = bytes.size();
+  if (!t_range) {
+    res.status = 200;
+    if (compress) res.set_content(std::move(bytes), mime);
+    else provide(res, std::move(bytes), mime);
+    return;
+  }
+  // httplib's parsed range: -1 for a position not given ("500-": to the end, "-500": the last 500).
+  const auto [first, last] = *t_range;
+  std::size_t begin = 0, end = 0;  // the bytes [begin, end]
+  if (first >= 0 && static_cast<std::size_t>(first) < size) {
+    begin = static_cast<std::size_t>(first);
+    end = last < 0 ? size - 1 : std::min(static_cast<std::size_t>(last), size - 1);
+  } else if (first < 0 && last > 0 && size > 0) {
+    begin = size - std::min(static_cast<std::size_t>(last), size);
+    end = size - 1;
+  } else {
+    return send_unsatisfiable(req, res, size);
+  }
+  res.status = 206;
+  res.set_header("Content-Range",
+                 "bytes " + std::to_string(begin) + "-" + std::to_string(end) + "/" + std::to_string(size));
+  provide(res, bytes.substr(begin, end - begin + 1), mime);
+}
+
+/// A file's bytes as the answer (whole or the range asked for), never compressed (see provide).
+void send_bytes(const httplib::Request& req, httplib::Response& res, std::string bytes, const std::string& mime) {
+  send_ranged(req, res, std::move(bytes), mime, false);
+}
+
+/// A JSON document (a job, a list, statistics) as a 200, or the range asked for.
+void send_document(const httplib::Request& req, httplib::Response& res, const json& body) {
+  send_ranged(req, res, dump(body), "application/json", true);
 }
 
 /// Ends the connection once this answer is written. cpp-httplib 0.11 sends a handler's
@@ -135,11 +178,6 @@ void close_after(const httplib::Request& req, httplib::Response& res) {
 /// read timed out (30 s).
 bool has_body(const httplib::Request& req) {
   return req.has_header("Content-Length") || req.has_header("Transfer-Encoding");
-}
-
-std::string range_problem(const httplib::Request& req) {
-  return "the Range header '" + req.get_header_value("Range") + "' is malformed or starts past the end of " +
-         req.path;
 }
 
 bool constant_time_equal(const std::string& a, const std::string& b) {
@@ -281,7 +319,20 @@ struct HttpServer::Impl {
     return "static";
   }
 
+  /// The GET (also HEAD) and DELETE routes, as registered with httplib, for unparsed_range.
+  std::vector<std::pair<std::regex, Handler>> get_routes, delete_routes;
+  void get(const std::string& pattern, Handler h) {
+    server.Get(pattern, h);
+    get_routes.emplace_back(std::regex(pattern), std::move(h));
+  }
+  void del(const std::string& pattern, Handler h) {
+    server.Delete(pattern, h);
+    delete_routes.emplace_back(std::regex(pattern), std::move(h));
+  }
+
   void setup();
+  httplib::Server::HandlerResponse pre_route(const httplib::Request& req, httplib::Response& res);
+  httplib::Server::HandlerResponse unparsed_range(const httplib::Request& req, httplib::Response& res);
   void cors_headers(httplib::Response& res) const;
   bool authorized(const httplib::Request& req) const;
   void post_job(const httplib::Request& req, httplib::Response& res, const httplib::ContentReader& reader);
@@ -336,93 +387,9 @@ void HttpServer::Impl::setup() {
   for (const RouteSpec& r : kRoutes)
     route_labels.emplace_back(std::regex(route_pattern(r.path)), r.path);
 
-  server.set_pre_routing_handler([this](const httplib::Request& req, httplib::Response& res) {
-    t_request_start = std::chrono::steady_clock::now();
-    t_pre_routed = true;
-    t_problem = {};
-    t_answer_size = 0;
-    // The query as sent, before anything reads a parameter (the token included). The request object
-    // is httplib's own, not const; only its parsed parameters are replaced.
-    const_cast<httplib::Request&>(req).params = parse_query(req.target);
-    // Both framings: RFC 9112 6.3 has a server refuse the message and close the connection (a
-    // proxy in front may have read it the other way: the shape of request smuggling).
-    if (req.has_header("Content-Length") && req.has_header("Transfer-Encoding")) {
-      res.set_header("Connection", "close");
-      send_problem(res, 400, "malformed request: both Content-Length and Transfer-Encoding are set");
-      return httplib::Server::HandlerResponse::Handled;
-    }
-    // Content-Length more than once with different values: the body's end is unknown (RFC 9110 8.6,
-    // RFC 9112 6.3: 400, and close the connection). cpp-httplib 0.11 took the first and a proxy in
-    // front may take the last. The same value repeated is one length (RFC 9110 8.6 allows it).
-    for (std::size_t i = 1; i < req.get_header_value_count("Content-Length"); ++i) {
-      const std::string first = req.get_header_value("Content-Length");
-      const std::string other = req.get_header_value("Content-Length", i);
-      if (other == first) continue;
-      res.set_header("Connection", "close");
-      send_problem(res, 400, "malformed request: Content-Length is given more than once with different values ('" +
-                                 first.substr(0, 20) + "', '" + other.substr(0, 20) + "')");
-      return httplib::Server::HandlerResponse::Handled;
-    }
-    // cpp-httplib 0.11 limits each header line (8 KiB) but not their number; the whole block has
-    // been read by now, so this bounds what the request costs from here on, and says why.
-    if (const std::size_t bytes = header_bytes(req); bytes > kMaxHeaderBytes) {
-      res.set_header("Connection", "close");
-      send_problem(res, 431, "the request's headers take " + std::to_string(bytes) + " bytes; at most " +
-                                 std::to_string(kMaxHeaderBytes) + " are accepted");
-      jobs.trim_memory_soon();
-      return httplib::Server::HandlerResponse::Handled;
-    }
-    // One byte range at most. cpp-httplib 0.11 builds the multipart answer to every range asked for
-    // in memory, overlapping or not: "bytes=0-,0-,..." (2 000 ranges in a 6 KB header) made a 2 GB
-    // answer of a 1 MB result. RFC 9110 14.2 lets a server ignore Range: a request for several gets
-    // the whole answer, a 200. (The request object is httplib's own, not const; only its parsed
-    // ranges change.)
-    if (req.ranges.size() > 1) const_cast<httplib::Request&>(req).ranges.clear();
-    if (req.method == "OPTIONS" && !options.cors_origin.empty()) {
-      res.status = 204;
-      res.set_header("Access-Control-Allow-Methods", "GET, POST, DELETE, OPTIONS");
-      res.set_header("Access-Control-Allow-Headers", "Authorization, Content-Type, Last-Event-ID");
-      res.set_header("Access-Control-Max-Age", "600");
-      return httplib::Server::HandlerResponse::Handled;
-    }
-    if (req.path.rfind("/api/", 0) == 0 && !authorized(req)) {
-      res.set_header("WWW-Authenticate", "Bearer realm=\"remeshd\"");
-      send_problem(res, 401, "this server requires 'Authorization: Bearer <token>'");
-      return httplib::Server::HandlerResponse::Handled;
-    }
-    if (req.path.rfind("/api/", 0) == 0) {
-      if (auto errors = repeated_query_keys(req); !errors.empty()) {
-        if (has_body(req)) res.set_header("Connection", "close");  // its body is not read
-        send_problem(res, 422, "invalid query: see errors", errors);
-        return httplib::Server::HandlerResponse::Handled;
-      }
-    }
-    return httplib::Server::HandlerResponse::Unhandled;
-  });
+  server.set_pre_routing_handler(
+      [this](const httplib::Request& req, httplib::Response& res) { return pre_route(req, res); });
   server.set_post_routing_handler([this](const httplib::Request& req, httplib::Response& res) {
-    // cpp-httplib 0.11 cuts the requested byte ranges out of a body but keeps the status the
-    // handler set: a client asking for bytes 0-10 of a job document got "200 OK" and 11 bytes. A
-    // partial answer is a 206 (RFC 9110 15.3.7).
-    if (res.status == 200 && !req.ranges.empty() &&
-        (res.has_header("Content-Range") || res.get_header_value("Content-Type").starts_with("multipart/byteranges")))
-      res.status = 206;
-    // An error is answered whole, whatever byte ranges the request asked for (see t_problem). A
-    // range past the end of an answer: cpp-httplib 0.11 clears the body, sets 416 and a
-    // Content-Length of 0 after the error handler has run; say which range, as every error does.
-    // A handler's error keeps its status: cpp-httplib 0.11 turns it into a 416 when the range
-    // starts past the end of the error's body ("Range: bytes=999999-" on a 404).
-    if (res.status >= 400 && (!req.ranges.empty() || res.status == 416)) {
-      res.headers.erase("Content-Range");
-      if (t_problem.status >= 400) {
-        res.status = t_problem.status;
-        res.set_content(t_problem.body, "application/problem+json");
-      } else if (res.status == 416) {
-        send_problem(res, 416, range_problem(req));
-        if (t_answer_size > 0) res.set_header("Content-Range", "bytes */" + std::to_string(t_answer_size));
-      }
-      res.headers.erase("Content-Length");
-      res.set_header("Content-Length", std::to_string(res.body.size()));
-    }
     cors_headers(res);
     res.set_header("X-Content-Type-Options", "nosniff");
     // (A client that says "Connection: close" has its connection closed by httplib.)
@@ -430,8 +397,9 @@ void HttpServer::Impl::setup() {
         !res.content_provider_)
       close_after(req, res);
   });
-  server.set_error_handler(httplib::Server::HandlerWithResponse([](const httplib::Request& req,
-                                                                   httplib::Response& res) {
+  server.set_error_handler(httplib::Server::HandlerWithResponse([this](const httplib::Request& req,
+                                                                       httplib::Response& res) {
+    if (!t_pre_routed && res.status == 416) return unparsed_range(req, res);
     // Answered before routing: timed from here (it was timed from this thread's previous request,
     // hours for an idle thread).
     if (!t_pre_routed) t_request_start = std::chrono::steady_clock::now();
@@ -478,14 +446,15 @@ void HttpServer::Impl::setup() {
 
   const std::string jobs_path = std::string(kPrefix) + "/jobs";
   const std::string job_path = jobs_path + "/([^/]+)";
-  server.Get("/healthz", guard([this](const auto& req, auto& res) { health(req, res); }));
-  server.Get("/metrics", guard([this](const auto&, auto& res) {
-               Gauges g = jobs.gauges();
-               g.open_streams = streams.load();
-               res.set_content(metrics.render(g), "text/plain; version=0.0.4; charset=utf-8");
-             }));
-  server.Get(std::string(kPrefix) + "/openapi\\.yaml",
-             guard([](const auto&, auto& res) { res.set_content(openapi_yaml(), "application/yaml"); }));
+  get("/healthz", guard([this](const auto& req, auto& res) { health(req, res); }));
+  get("/metrics", guard([this](const auto&, auto& res) {
+        Gauges g = jobs.gauges();
+        g.open_streams = streams.load();
+        res.set_content(metrics.render(g), "text/plain; version=0.0.4; charset=utf-8");
+      }));
+  get(std::string(kPrefix) + "/openapi\\.yaml", guard([](const auto& req, auto& res) {
+        send_ranged(req, res, openapi_yaml(), "application/yaml", true);
+      }));
   server.Post(jobs_path, [this](const httplib::Request& req, httplib::Response& res,
                                 const httplib::ContentReader& reader) {
     try {
@@ -497,17 +466,17 @@ void HttpServer::Impl::setup() {
       send_problem(res, 500, "internal error");
     }
   });
-  server.Get(jobs_path, guard(known_query({"state", "limit", "offset"},
-                                          [this](const auto& req, auto& res) { list_jobs(req, res); })));
-  server.Get(job_path, guard(known_query({}, [this](const auto& req, auto& res) { get_job(req, res); })));
-  server.Delete(job_path, guard(known_query({}, [this](const auto& req, auto& res) { delete_job(req, res); })));
-  server.Get(job_path + "/events",
-             guard(known_query({"lastEventId"}, [this](const auto& req, auto& res) { events(req, res); })));
-  server.Get(job_path + "/result",
-             guard(known_query({"mesh", "format"}, [this](const auto& req, auto& res) { result(req, res); })));
-  server.Get(job_path + "/stats",
-             guard(known_query({"format"}, [this](const auto& req, auto& res) { stats(req, res); })));
-  server.Get("/.*", guard([this](const auto& req, auto& res) { static_files(req, res); }));
+  get(jobs_path, guard(known_query({"state", "limit", "offset"},
+                                   [this](const auto& req, auto& res) { list_jobs(req, res); })));
+  get(job_path, guard(known_query({}, [this](const auto& req, auto& res) { get_job(req, res); })));
+  del(job_path, guard(known_query({}, [this](const auto& req, auto& res) { delete_job(req, res); })));
+  get(job_path + "/events",
+      guard(known_query({"lastEventId"}, [this](const auto& req, auto& res) { events(req, res); })));
+  get(job_path + "/result",
+      guard(known_query({"mesh", "format"}, [this](const auto& req, auto& res) { result(req, res); })));
+  get(job_path + "/stats",
+      guard(known_query({"format"}, [this](const auto& req, auto& res) { stats(req, res); })));
+  get("/.*", guard([this](const auto& req, auto& res) { static_files(req, res); }));
   // Any other POST, PUT or PATCH: no such route. Routed with a content reader so that a request
   // without a body is answered at once (cpp-httplib 0.11 otherwise waits for a body that has no
   // length until its read timeout, 30 s); a body, if any, is read and dropped.
@@ -519,6 +488,107 @@ void HttpServer::Impl::setup() {
   server.Post("/.*", no_route);
   server.Put("/.*", no_route);
   server.Patch("/.*", no_route);
+}
+
+/// Checks every request before it is routed (and one cpp-httplib answered before routing, see
+/// unparsed_range): framing, header size, auth, repeated query keys; takes the query and the byte
+/// range out of httplib's hands.
+httplib::Server::HandlerResponse HttpServer::Impl::pre_route(const httplib::Request& req,
+                                                             httplib::Response& res) {
+  t_request_start = std::chrono::steady_clock::now();
+  t_pre_routed = true;
+  // The query as sent, before anything reads a parameter (the token included), and the byte range
+  // taken for the handler to apply (t_range), so that httplib applies none. The request object is
+  // httplib's own, not const; only its parsed parameters and ranges change.
+  auto& request = const_cast<httplib::Request&>(req);
+  request.params = parse_query(req.target);
+  t_range.reset();
+  if (req.ranges.size() == 1 && (req.method == "GET" || req.method == "HEAD")) t_range = req.ranges.front();
+  request.ranges.clear();
+  // Both framings: RFC 9112 6.3 has a server refuse the message and close the connection (a
+  // proxy in front may have read it the other way: the shape of request smuggling).
+  if (req.has_header("Content-Length") && req.has_header("Transfer-Encoding")) {
+    res.set_header("Connection", "close");
+    send_problem(res, 400, "malformed request: both Content-Length and Transfer-Encoding are set");
+    return httplib::Server::HandlerResponse::Handled;
+  }
+  // Content-Length more than once with different values: the body's end is unknown (RFC 9110 8.6,
+  // RFC 9112 6.3: 400, and close the connection). cpp-httplib 0.11 took the first and a proxy in
+  // front may take the last. The same value repeated is one length (RFC 9110 8.6 allows it).
+  for (std::size_t i = 1; i < req.get_header_value_count("Content-Length"); ++i) {
+    const std::string first = req.get_header_value("Content-Length");
+    const std::string other = req.get_header_value("Content-Length", i);
+    if (other == first) continue;
+    res.set_header("Connection", "close");
+    send_problem(res, 400, "malformed request: Content-Length is given more than once with different values ('" +
+                               first.substr(0, 20) + "', '" + other.substr(0, 20) + "')");
+    return httplib::Server::HandlerResponse::Handled;
+  }
+  // cpp-httplib 0.11 limits each header line (8 KiB) but not their number; the whole block has
+  // been read by now, so this bounds what the request costs from here on, and says why.
+  if (const std::size_t bytes = header_bytes(req); bytes > kMaxHeaderBytes) {
+    res.set_header("Connection", "close");
+    send_problem(res, 431, "the request's headers take " + std::to_string(bytes) + " bytes; at most " +
+                               std::to_string(kMaxHeaderBytes) + " are accepted");
+    jobs.trim_memory_soon();
+    return httplib::Server::HandlerResponse::Handled;
+  }
+  if (req.method == "OPTIONS" && !options.cors_origin.empty()) {
+    res.status = 204;
+    res.set_header("Access-Control-Allow-Methods", "GET, POST, DELETE, OPTIONS");
+    res.set_header("Access-Control-Allow-Headers", "Authorization, Content-Type, Last-Event-ID");
+    res.set_header("Access-Control-Max-Age", "600");
+    return httplib::Server::HandlerResponse::Handled;
+  }
+  if (req.path.rfind("/api/", 0) == 0 && !authorized(req)) {
+    res.set_header("WWW-Authenticate", "Bearer realm=\"remeshd\"");
+    send_problem(res, 401, "this server requires 'Authorization: Bearer <token>'");
+    return httplib::Server::HandlerResponse::Handled;
+  }
+  if (req.path.rfind("/api/", 0) == 0) {
+    if (auto errors = repeated_query_keys(req); !errors.empty()) {
+      if (has_body(req)) res.set_header("Connection", "close");  // its body is not read
+      send_problem(res, 422, "invalid query: see errors", errors);
+      return httplib::Server::HandlerResponse::Handled;
+    }
+  }
+  return httplib::Server::HandlerResponse::Unhandled;
+}
+
+/// A Range header cpp-httplib 0.11 cannot parse ("items=0-5", "bytes=zz", "bytes=5-1", "Bytes=0-5")
+/// it answers with a bare 416 before routing (Server::process_request): neither the pre-routing
+/// handler nor a route sees the request, the error handler is the first to. Routed here as httplib
+/// would have: a unit other than bytes is ignored (RFC 9110 14.2: the whole answer), the unit's case
+/// does not matter ("Bytes=0-5" is bytes 0-5), and a malformed bytes range is kMalformed: a 416 that
+/// gives the length ("bytes */N") from the handlers that honour ranges, the whole answer from the
+/// others (the event stream). GET, HEAD and DELETE only: a POST, PUT or PATCH keeps its 416 (its
+/// body, unread, closes the connection).
+httplib::Server::HandlerResponse HttpServer::Impl::unparsed_range(const httplib::Request& req,
+                                                                  httplib::Response& res) {
+  auto& request = const_cast<httplib::Request&>(req);
+  request.ranges.clear();
+  res.status = 200;
+  using Answer = httplib::Server::HandlerResponse;
+  if (pre_route(req, res) == Answer::Handled) return Answer::Handled;
+  const bool get = req.method == "GET" || req.method == "HEAD";
+  if (!get && req.method != "DELETE") {
+    res.set_header("Connection", "close");
+    send_problem(res, 416, range_problem(req));
+    return Answer::Handled;
+  }
+  const std::string range = req.get_header_value("Range");
+  const bool bytes = range.size() >= 6 && std::equal(range.begin(), range.begin() + 6, "bytes=", [](char a, char b) {
+                       return std::tolower(static_cast<unsigned char>(a)) == b;
+                     });
+  httplib::Ranges parsed;
+  if (get && bytes && !httplib::detail::parse_range_header("bytes=" + range.substr(6), parsed)) t_range = kMalformed;
+  else if (get && parsed.size() == 1) t_range = parsed.front();
+  const auto& routes = get ? get_routes : delete_routes;
+  const auto route = std::find_if(routes.begin(), routes.end(),
+                                  [&](const auto& r) { return std::regex_match(req.path, request.matches, r.first); });
+  if (route == routes.end()) send_problem(res, 404, "no such route: " + req.method + " " + req.path);
+  else route->second(req, res);
+  return Answer::Handled;
 }
 
 void HttpServer::Impl::health(const httplib::Request&, httplib::Response& res) {
@@ -705,7 +775,7 @@ void HttpServer::Impl::post_job(const httplib::Request& req, httplib::Response& 
 }
 
 void HttpServer::Impl::get_job(const httplib::Request& req, httplib::Response& res) {
-  if (auto rec = find_job(req, res)) send_json(res, 200, document(*rec));
+  if (auto rec = find_job(req, res)) send_document(req, res, document(*rec));
 }
 
 void HttpServer::Impl::list_jobs(const httplib::Request& req, httplib::Response& res) {
@@ -735,7 +805,7 @@ void HttpServer::Impl::list_jobs(const httplib::Request& req, httplib::Response&
   JobManager::Page page = jobs.list(state, limit, offset);
   json list = json::array();
   for (const JobRecord& r : page.jobs) list.push_back(document(r));
-  send_json(res, 200, {{"jobs", list}, {"total", page.total}, {"limit", limit}, {"offset", offset}});
+  send_document(req, res, {{"jobs", list}, {"total", page.total}, {"limit", limit}, {"offset", offset}});
 }
 
 void HttpServer::Impl::delete_job(const httplib::Request& req, httplib::Response& res) {
@@ -907,10 +977,10 @@ void HttpServer::Impl::stats(const httplib::Request& req, httplib::Response& res
   }
   if (format == "csv") {
     res.set_header("Content-Disposition", remesh::api::content_disposition("inline", rec->filename, "-stats.csv"));
-    res.set_content(remesh::stats_to_csv(*rows), "text/csv; charset=utf-8");
+    send_ranged(req, res, remesh::stats_to_csv(*rows), "text/csv; charset=utf-8", true);
     return;
   }
-  send_json(res, 200, {{"rows", *rows}});
+  send_document(req, res, {{"rows", *rows}});
 }
 
 void HttpServer::Impl::static_files(const httplib::Request& req, httplib::Response& res) {
@@ -921,7 +991,7 @@ void HttpServer::Impl::static_files(const httplib::Request& req, httplib::Respon
   auto file = static_file(web_root, req.path);
   if (!file) {
     if (req.path == "/" || req.path == "/index.html") {
-      res.set_content(missing_web_root_page(web_root), "text/html; charset=utf-8");
+      send_ranged(req, res, missing_web_root_page(web_root), "text/html; charset=utf-8", true);
       return;
     }
     send_problem(res, 404, "no such file: " + req.path.substr(0, 200));
