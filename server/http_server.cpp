@@ -8,6 +8,8 @@
 #include <cctype>
 #include <cmath>
 #include <chrono>
+#include <condition_variable>
+#include <mutex>
 #include <regex>
 #include <string_view>
 #include <utility>
@@ -272,6 +274,9 @@ struct HttpServer::Impl {
   std::atomic<std::size_t> streams{0};
   std::vector<std::pair<std::regex, std::string>> route_labels;
   std::chrono::steady_clock::time_point started = std::chrono::steady_clock::now();
+  std::mutex served_mutex;
+  std::condition_variable served_changed;
+  bool served = false;  ///< serve() has returned
 
   Impl(const Options& o, JobManager& j, Metrics& m, Logger& l, std::filesystem::path root)
       : options(o), jobs(j), metrics(m), log(l), web_root(std::move(root)) {}
@@ -1019,11 +1024,22 @@ int HttpServer::bind() {
   return port;
 }
 
-bool HttpServer::serve() { return impl_->server.listen_after_bind(); }
+bool HttpServer::serve() {
+  const bool ok = impl_->server.listen_after_bind();
+  {
+    std::lock_guard lock(impl_->served_mutex);
+    impl_->served = true;
+  }
+  impl_->served_changed.notify_all();
+  return ok;
+}
 
-void HttpServer::stop() {
+bool HttpServer::stop(double grace_seconds) {
   impl_->jobs.wake_all();
   impl_->server.stop();
+  std::unique_lock lock(impl_->served_mutex);
+  return impl_->served_changed.wait_for(lock, std::chrono::duration<double>(grace_seconds),
+                                        [this] { return impl_->served; });
 }
 
 std::size_t HttpServer::open_streams() const { return impl_->streams.load(); }

@@ -26,8 +26,10 @@ class HttpServer {
   int bind();
   /// Serves until stop() is called. Returns false if the server failed.
   bool serve();
-  /// Stops accepting and ends open streams; serve() returns once in-flight requests finish.
-  void stop();
+  /// Stops accepting and ends open streams, then waits up to `grace_seconds` for serve() to return,
+  /// which it does once the requests in flight are answered. Returns whether it did: a client can
+  /// hold a connection as long as it likes (see main.cpp).
+  bool stop(double grace_seconds);
   /// Open SSE streams.
   std::size_t open_streams() const;
 

@@ -7,6 +7,7 @@
 #endif
 
 #include <cstdio>
+#include <cstdlib>
 #include <thread>
 
 #include "http_server.h"
@@ -16,6 +17,11 @@
 #include "metrics.h"
 #include "options.h"
 #include "static_files.h"
+
+namespace {
+/// How long a shutdown waits for the requests in flight (after the jobs have stopped).
+constexpr double kShutdownGraceSeconds = 3;
+}  // namespace
 
 int main(int argc, char** argv) {
   using namespace remeshd;
@@ -73,7 +79,21 @@ int main(int argc, char** argv) {
       sigwait(&signals, &sig);
       log.info("shutdown", {str("signal", sig == SIGTERM ? "SIGTERM" : sig == SIGINT ? "SIGINT" : "internal")});
       jobs.shutdown();  // interrupts running jobs; they stay 'running' on disk and run again on start
-      http.stop();
+      // serve() returns when cpp-httplib 0.11's thread pool has joined every connection's thread,
+      // and a connection ends when its client is done: one that sends a byte now and then (each
+      // restarts the 30 s read timeout) held the exit for as long as it kept sending (QA: 34-42 s
+      // after SIGTERM, a request sent a byte every 0.5 s or an upload at 1 KB/s). httplib keeps the
+      // accepted sockets to itself (its per-connection loop is private), so they cannot be shut
+      // down from here; past a grace for the requests in flight, the process exits without them.
+      // Nothing is lost: the jobs are stopped and stored above, every file is written to a
+      // temporary name and renamed (what a cut-off upload left is removed at the next start, as
+      // after a kill -9), and the clients still connected see the connection close.
+      if (!http.stop(kShutdownGraceSeconds)) {
+        log.warn("shutdown", {str("detail", "connections still open after the grace are closed"),
+                              num("grace_seconds", kShutdownGraceSeconds)});
+        log.info("stopped", {});
+        std::_Exit(0);
+      }
     });
     bool ok = http.serve();
     pthread_kill(signal_thread.native_handle(), SIGTERM);  // no-op if it already ran

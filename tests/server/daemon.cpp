@@ -225,6 +225,26 @@ std::string raw_exchange(int port, const std::vector<std::string>& parts, double
   return answer;
 }
 
+std::thread slow_client(int port, std::string head, std::string unit, double period, const std::atomic<bool>& stop,
+                        double limit) {
+  return std::thread([=, &stop] {
+    const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
+    if (fd < 0) return;
+    sockaddr_in addr{};
+    addr.sin_family = AF_INET;
+    addr.sin_port = htons(static_cast<std::uint16_t>(port));
+    addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    const auto until = std::chrono::steady_clock::now() + std::chrono::duration<double>(limit);
+    if (::connect(fd, reinterpret_cast<sockaddr*>(&addr), sizeof addr) == 0 &&
+        ::send(fd, head.data(), head.size(), MSG_NOSIGNAL) == static_cast<ssize_t>(head.size())) {
+      while (!stop && std::chrono::steady_clock::now() < until &&
+             ::send(fd, unit.data(), unit.size(), MSG_NOSIGNAL) == static_cast<ssize_t>(unit.size()))
+        std::this_thread::sleep_for(std::chrono::duration<double>(period));
+    }
+    ::close(fd);
+  });
+}
+
 std::size_t count_files(const fs::path& dir) {
   std::size_t n = 0;
   std::error_code ec;

@@ -3,11 +3,13 @@
 // directory, talk to it with httplib::Client, stop it with SIGTERM or SIGKILL.
 #include <httplib.h>
 
+#include <atomic>
 #include <chrono>
 #include <filesystem>
 #include <functional>
 #include <optional>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -81,6 +83,11 @@ SseStream read_events(int port, const std::string& path, const httplib::Headers&
 std::string raw_exchange(int port, const std::string& request, double timeout);
 /// The same with the request sent in parts, `pause` seconds apart (each part its own segment).
 std::string raw_exchange(int port, const std::vector<std::string>& parts, double pause, double timeout);
+
+/// A slow client on a thread of its own: connects to 127.0.0.1:`port`, sends `head`, then `unit`
+/// every `period` seconds until `stop` is set, a send fails or `limit` seconds have passed.
+std::thread slow_client(int port, std::string head, std::string unit, double period, const std::atomic<bool>& stop,
+                        double limit = 60);
 
 /// Files (recursively) under a directory.
 std::size_t count_files(const std::filesystem::path& dir);
