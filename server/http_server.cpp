@@ -182,6 +182,24 @@ bool has_body(const httplib::Request& req) {
   return req.has_header("Content-Length") || req.has_header("Transfer-Encoding");
 }
 
+/// The transfer codings of the request, in order, lower case ("gzip, Chunked" -> gzip, chunked).
+std::vector<std::string> transfer_codings(const httplib::Request& req) {
+  std::string list;
+  for (std::size_t i = 0; i < req.get_header_value_count("Transfer-Encoding"); ++i)
+    list.append(",").append(req.get_header_value("Transfer-Encoding", i));
+  std::vector<std::string> codings;
+  for (std::size_t begin = 0; begin < list.size();) {
+    const std::size_t end = std::min(list.find(',', begin), list.size());
+    std::string coding = list.substr(begin, end - begin);
+    begin = end + 1;
+    coding.erase(0, coding.find_first_not_of(" \t"));
+    coding.erase(coding.find_last_not_of(" \t") + 1);
+    for (char& c : coding) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    if (!coding.empty()) codings.push_back(std::move(coding));
+  }
+  return codings;
+}
+
 bool constant_time_equal(const std::string& a, const std::string& b) {
   if (a.size() != b.size()) return false;
   unsigned char diff = 0;
@@ -516,6 +534,22 @@ httplib::Server::HandlerResponse HttpServer::Impl::pre_route(const httplib::Requ
     res.set_header("Connection", "close");
     send_problem(res, 400, "malformed request: both Content-Length and Transfer-Encoding are set");
     return httplib::Server::HandlerResponse::Handled;
+  }
+  // cpp-httplib 0.11 reads a body as chunked only when Transfer-Encoding is exactly "chunked"; any
+  // other value it read as a body without a length, to the end of the connection, and answered 400
+  // after the 30 s read timeout. RFC 9112 6.3: chunked not last is a 400 (the length is unknown);
+  // 6.1: a coding before it that the server does not apply (gzip, chunked) is a 501. Both close.
+  if (req.has_header("Transfer-Encoding")) {
+    const std::vector<std::string> codings = transfer_codings(req);
+    if (codings.size() != 1 || codings.front() != "chunked") {
+      const bool chunked_last = !codings.empty() && codings.back() == "chunked";
+      res.set_header("Connection", "close");
+      send_problem(res, chunked_last ? 501 : 400,
+                   "Transfer-Encoding '" + req.get_header_value("Transfer-Encoding").substr(0, 60) + "': " +
+                       (chunked_last ? "no coding but chunked is implemented"
+                                     : "the body's length is unknown (chunked must be the last coding)"));
+      return httplib::Server::HandlerResponse::Handled;
+    }
   }
   // Content-Length more than once with different values: the body's end is unknown (RFC 9110 8.6,
   // RFC 9112 6.3: 400, and close the connection). cpp-httplib 0.11 took the first and a proxy in

@@ -779,6 +779,23 @@ TEST_CASE("remeshd: requests a black-box review found answered wrongly", "[serve
       10);
   CHECK(repeated.rfind("HTTP/1.1 200", 0) == 0);
 
+  // A Transfer-Encoding other than chunked: at once (it waited for the end of the connection, 30 s,
+  // then said 400): 400 when chunked is not the last coding, 501 for a coding before it (RFC 9112
+  // 6.1, 6.3). The coding's case does not matter.
+  for (const auto& [coding, status] : {std::pair{"gzip", "400"}, std::pair{"chunked, identity", "400"},
+                                       std::pair{"gzip, chunked", "501"}, std::pair{"Chunked", "404"}}) {
+    CAPTURE(coding);
+    const auto t0 = std::chrono::steady_clock::now();
+    const std::string answer = raw_exchange(
+        d.port(), std::string("POST /api/v1/nope HTTP/1.1\r\nHost: x\r\nConnection: close\r\nTransfer-Encoding: ") +
+                      coding + "\r\n\r\n3\r\nabc\r\n0\r\n\r\n",
+        10);
+    INFO(answer);
+    CHECK(answer.rfind(std::string("HTTP/1.1 ") + status, 0) == 0);
+    CHECK(answer.find("application/problem+json") != std::string::npos);
+    CHECK(std::chrono::steady_clock::now() - t0 < std::chrono::seconds(3));
+  }
+
   // Headers of more than 64 KiB in all (each line under httplib's 8 KiB): 431, and the daemon serves on.
   std::string flood = "GET /healthz HTTP/1.1\r\nHost: x\r\n";
   for (int i = 0; i < 20; ++i) flood += "X-Fill-" + std::to_string(i) + ": " + std::string(8000, 'a') + "\r\n";
