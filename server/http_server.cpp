@@ -11,6 +11,7 @@
 #include <condition_variable>
 #include <mutex>
 #include <regex>
+#include <stdexcept>
 #include <string_view>
 #include <utility>
 
@@ -974,6 +975,10 @@ void HttpServer::Impl::result(const httplib::Request& req, httplib::Response& re
   std::filesystem::path path;
   try {
     path = jobs.file(rec->id, mesh + "." + format);
+  } catch (const std::range_error& e) {
+    // The format cannot hold this mesh (STL and GLB store float32: a mesh placed beyond 3.4e38).
+    send_problem(res, 422, std::string("this mesh cannot be written as ") + format + ": " + e.what());
+    return;
   } catch (const std::exception& e) {
     send_problem(res, 500, std::string("cannot produce the file: ") + e.what());
     return;

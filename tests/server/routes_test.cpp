@@ -254,6 +254,31 @@ TEST_CASE("remeshd: a job whose mesh lies over itself throughout is said to be l
   CHECK(done["crossing_pairs"].is_null());
 }
 
+TEST_CASE("remeshd: a result float32 cannot hold succeeds, and its STL and GLB are refused saying why", "[server]") {
+  // A ball placed 1e39 from the origin: its OBJ, PLY and OFF hold it, STL and GLB (float32) not.
+  TempDir tmp;
+  Daemon d(tmp.path / "data");
+  auto c = d.client();
+  remesh::TriMesh far = remesh::test::make_icosphere(2);
+  for (auto v : far.vertices()) far.point(v) += remesh::Vec3(1e39, 0, 0);
+  auto r = submit_raw(c, remesh::write_mesh(far, remesh::Format::Obj), "emin=0.2&emax=0.35&filename=far.obj");
+  REQUIRE(r);
+  REQUIRE(r->status == 202);
+  const json done = wait_final(c, body_of(r)["id"]);
+  REQUIRE(done["state"] == "succeeded");
+  const std::string base = "/api/v1/jobs/" + done["id"].get<std::string>() + "/result";
+  auto obj = c.Get(base + "?format=obj");
+  REQUIRE(obj);
+  CHECK(obj->status == 200);
+  for (const char* q : {"?format=stl", "?format=glb", "?mesh=dual&format=glb"}) {
+    INFO(q);
+    auto g = c.Get(base + q);
+    REQUIRE(g);
+    CHECK(g->status == 422);
+    CHECK(body_of(g)["detail"].get<std::string>().find("float32") != std::string::npos);
+  }
+}
+
 TEST_CASE("remeshd: relax_dual relaxes the dual's bonds, and its downloads are that dual", "[server]") {
   TempDir tmp;
   Daemon d(tmp.path / "data", {"--workers", "2"});
