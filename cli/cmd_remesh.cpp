@@ -268,10 +268,13 @@ int run_remesh(const std::vector<std::string>& args) {
   write_mesh_file(to_soup(mesh), job.out);
   std::optional<DualStats> dual_summary;
   std::optional<BondRelaxation> relaxed;
+  bool relax_stopped = false;
   if (job.dual_out) {
     PolyMesh dual = trivalent_dual(mesh, &*reference);
     if (job.params.relax_dual)
       relaxed = relax_bonds(dual, job.params.e_min, job.params.e_max, *reference, job.params.threads, stop.get_token());
+    // Stopped by Ctrl-C (it returns at once then); one after it, while the files are written, is not.
+    relax_stopped = relaxed && stop.stop_requested();
     write_mesh_file(to_soup(dual), *job.dual_out);
     if (!job.quiet) dual_summary = dual_stats(dual, job.params.e_min, job.params.e_max);  // for the summary only
   }
@@ -286,7 +289,7 @@ int run_remesh(const std::vector<std::string>& args) {
     return 1;
   }
   // Ctrl-C after the run, while the dual's bonds were relaxed: the dual is written as far as it got.
-  if (stop.stop_requested()) {
+  if (relax_stopped) {
     std::cerr << "remesh: cancelled while relaxing the dual's bonds; wrote the mesh to " << job.out
               << " and the partly relaxed dual to " << *job.dual_out << "\n";
     return 1;

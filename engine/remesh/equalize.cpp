@@ -645,8 +645,8 @@ Result equalize(TriMesh& mesh, const Params& requested, const OnIteration& on_it
     // thesis: fold_guard.h).
     PhaseTimer move_timer(phases.filter);
     const std::vector<Vec3> before = snapshot_points(mesh);
-    // Not in the thesis: until the cleanup starts (and in the first half of the iterations, where
-    // it does not run: run_all_iterations, cleanup off), vertices on the reference's creases move
+    // Not in the thesis: until the cleanup starts (and in the first half of the iterations with the
+    // cleanup off), vertices on the reference's creases move
     // along them only (crease_lines.h). The creases are lost, if at all, in the first iterations,
     // while the mesh is coarse and the filter's moves are long; held in every iteration they cost
     // freedom: cheese's refinement had 34 crossing face pairs over the five intervals of bench

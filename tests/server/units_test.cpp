@@ -212,9 +212,12 @@ TEST_CASE("run_job hands each result file to the sink once, and none when cancel
   // The same sphere placed 1e39 from the origin: STL and GLB (float32) cannot hold it and are not
   // written; the job's other files are (the run failed while writing them).
   {
-    remesh::TriMesh far = sphere;
+    // 1e25 across (near 1e39 doubles lie about 1e23 apart: the sphere of radius 10 would be flat).
+    remesh::TriMesh far = remesh::test::make_icosphere(2, 1e25);
     for (auto v : far.vertices()) far.point(v) += remesh::Vec3(1e39, 0, 0);
     remesh::api::JobRecord far_job = job;
+    far_job.params.e_min *= 1e24;
+    far_job.params.e_max *= 1e24;
     std::set<std::string> written;
     const RunOutput far_out = run_job(far_job, remesh::write_mesh(far, remesh::Format::Off), 1, {}, std::stop_token{},
                                       [&](const std::string& name, std::string_view) { written.insert(name); });
