@@ -166,6 +166,10 @@ void send_document(const httplib::Request& req, httplib::Response& res, const js
 /// and so is the body, cut to the range asked for (httplib would cut the provider's bytes again).
 void close_after(const httplib::Request& req, httplib::Response& res) {
   const_cast<httplib::Request&>(req).ranges.clear();
+  // httplib writes no body for HEAD, so the provider would never run and the connection would stay:
+  // answered as a GET (the connection ends with it anyway; review: a HEAD with two Content-Lengths
+  // got its 400 and the next request on the connection was served).
+  if (req.method == "HEAD") const_cast<httplib::Request&>(req).method = "GET";
   res.headers.erase("Keep-Alive");
   auto body = std::make_shared<std::string>(std::move(res.body));
   res.body.clear();
@@ -542,13 +546,22 @@ httplib::Server::HandlerResponse HttpServer::Impl::pre_route(const httplib::Requ
   // 6.1: a coding before it that the server does not apply (gzip, chunked) is a 501. Both close.
   if (req.has_header("Transfer-Encoding")) {
     const std::vector<std::string> codings = transfer_codings(req);
-    if (codings.size() != 1 || codings.front() != "chunked") {
-      const bool chunked_last = !codings.empty() && codings.back() == "chunked";
+    // One field whose whole value is chunked (any case, blanks around it): httplib reads only
+    // that as chunked, and read "chunked," (an empty item, dropped from `codings`) to the end.
+    std::string only = req.get_header_value("Transfer-Encoding");
+    only.erase(0, only.find_first_not_of(" \t"));
+    only.erase(only.find_last_not_of(" \t") + 1);
+    const bool plain_chunked = req.get_header_value_count("Transfer-Encoding") == 1 && codings.size() == 1 &&
+                               codings.front() == "chunked" && only.size() == 7;
+    if (!plain_chunked) {
+      // chunked alone, but spelt otherwise ("chunked,", or given on two lines): a 400 as well.
+      const bool chunked_last = codings.size() > 1 && codings.back() == "chunked";
       res.set_header("Connection", "close");
       send_problem(res, chunked_last ? 501 : 400,
                    "Transfer-Encoding '" + req.get_header_value("Transfer-Encoding").substr(0, 60) + "': " +
-                       (chunked_last ? "no coding but chunked is implemented"
-                                     : "the body's length is unknown (chunked must be the last coding)"));
+                       (chunked_last                                         ? "no coding but chunked is implemented"
+                        : codings.size() == 1 && codings.front() == "chunked" ? "write it as the one value 'chunked'"
+                                       : "the body's length is unknown (chunked must be the last coding)"));
       return httplib::Server::HandlerResponse::Handled;
     }
   }
@@ -562,6 +575,26 @@ httplib::Server::HandlerResponse HttpServer::Impl::pre_route(const httplib::Requ
     res.set_header("Connection", "close");
     send_problem(res, 400, "malformed request: Content-Length is given more than once with different values ('" +
                                first.substr(0, 20) + "', '" + other.substr(0, 20) + "')");
+    return httplib::Server::HandlerResponse::Handled;
+  }
+  // A Content-Length that is not a number ("3, 10" on one line: httplib took 3) leaves the body's
+  // end unknown, as two different ones do.
+  if (req.has_header("Content-Length")) {
+    const std::string length = req.get_header_value("Content-Length");
+    if (length.empty() || length.find_first_not_of("0123456789") != std::string::npos) {
+      res.set_header("Connection", "close");
+      send_problem(res, 400, "malformed request: Content-Length '" + length.substr(0, 20) + "' is not a number");
+      return httplib::Server::HandlerResponse::Handled;
+    }
+  }
+  // cpp-httplib 0.11 reads no body for GET, HEAD and OPTIONS: the bytes of one would be read as the
+  // next request on the connection (review: GET /healthz with a body that was 'GET /metrics' served
+  // both). Refused, and the connection closed.
+  if ((req.method == "GET" || req.method == "HEAD" || req.method == "OPTIONS") &&
+      (req.has_header("Transfer-Encoding") ||
+       (req.has_header("Content-Length") && req.get_header_value("Content-Length").find_first_not_of('0') != std::string::npos))) {
+    res.set_header("Connection", "close");
+    send_problem(res, 400, "malformed request: a " + req.method + " request carries no body here");
     return httplib::Server::HandlerResponse::Handled;
   }
   // cpp-httplib 0.11 limits each header line (8 KiB) but not their number; the whole block has
@@ -623,6 +656,8 @@ httplib::Server::HandlerResponse HttpServer::Impl::unparsed_range(const httplib:
   httplib::Ranges parsed;
   if (get && bytes && !httplib::detail::parse_range_header("bytes=" + range.substr(6), parsed)) t_range = kMalformed;
   else if (get && parsed.size() == 1) t_range = parsed.front();
+  // A DELETE routed from here has its body (if any) unread: the connection ends after the answer.
+  if (!get && has_body(req)) res.set_header("Connection", "close");
   const auto& routes = get ? get_routes : delete_routes;
   const auto route = std::find_if(routes.begin(), routes.end(),
                                   [&](const auto& r) { return std::regex_match(req.path, request.matches, r.first); });

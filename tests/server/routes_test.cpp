@@ -259,9 +259,10 @@ TEST_CASE("remeshd: a result float32 cannot hold succeeds, and its STL and GLB a
   TempDir tmp;
   Daemon d(tmp.path / "data");
   auto c = d.client();
-  remesh::TriMesh far = remesh::test::make_icosphere(2);
+  // (1e25 across: near 1e39 doubles lie about 1e23 apart, so a unit ball would be flattened.)
+  remesh::TriMesh far = remesh::test::make_icosphere(2, 1e25);
   for (auto v : far.vertices()) far.point(v) += remesh::Vec3(1e39, 0, 0);
-  auto r = submit_raw(c, remesh::write_mesh(far, remesh::Format::Obj), "emin=0.2&emax=0.35&filename=far.obj");
+  auto r = submit_raw(c, remesh::write_mesh(far, remesh::Format::Obj), "emin=0.2e25&emax=0.35e25&filename=far.obj");
   REQUIRE(r);
   REQUIRE(r->status == 202);
   const json done = wait_final(c, body_of(r)["id"]);
@@ -786,12 +787,18 @@ TEST_CASE("remeshd: requests a black-box review found answered wrongly", "[serve
   // ... also when the next request comes in a segment of its own, after the answer: cpp-httplib
   // sent "Connection: close" but read on, and served it. The connection ends at once (not after
   // the 5 s keep-alive), for both framings refused.
-  for (const std::string& framing : {std::string("Content-Length: 3\r\nContent-Length: 40"),
-                                     std::string("Content-Length: 40\r\nTransfer-Encoding: chunked")}) {
-    CAPTURE(framing);
+  // HEAD too (httplib writes no body for it, which is how the connection was ended: a review found
+  // the next request served), and Content-Length "3, 10" on one line (httplib took 3).
+  for (const auto& [method, framing] :
+       {std::pair{"POST", std::string("Content-Length: 3\r\nContent-Length: 40")},
+        std::pair{"POST", std::string("Content-Length: 40\r\nTransfer-Encoding: chunked")},
+        std::pair{"HEAD", std::string("Content-Length: 3\r\nContent-Length: 40")},
+        std::pair{"POST", std::string("Content-Length: 3, 10")}}) {
+    CAPTURE(method, framing);
     const auto t0 = std::chrono::steady_clock::now();
     const std::string later = raw_exchange(
-        d.port(), {"POST /api/v1/nope HTTP/1.1\r\nHost: x\r\n" + framing + "\r\n\r\n", "GET /healthz HTTP/1.1\r\nHost: x\r\n\r\n"},
+        d.port(), {std::string(method) + " /api/v1/nope HTTP/1.1\r\nHost: x\r\n" + framing + "\r\n\r\n",
+                   "GET /healthz HTTP/1.1\r\nHost: x\r\n\r\n"},
         0.5, 10);
     INFO(later);
     CHECK(later.rfind("HTTP/1.1 400", 0) == 0);
@@ -803,12 +810,27 @@ TEST_CASE("remeshd: requests a black-box review found answered wrongly", "[serve
       d.port(), "GET /healthz HTTP/1.1\r\nHost: x\r\nContent-Length: 0\r\nContent-Length: 0\r\nConnection: close\r\n\r\n",
       10);
   CHECK(repeated.rfind("HTTP/1.1 200", 0) == 0);
+  // A body on a GET (httplib reads none: the body was served as the next request), and on a DELETE
+  // routed past a Range httplib cannot parse (its body was not read either): refused or answered,
+  // and the connection ends there.
+  const std::string inner = "GET /metrics HTTP/1.1\r\nHost: x\r\n\r\n";
+  for (const std::string& head :
+       {"GET /healthz HTTP/1.1\r\nHost: x\r\nContent-Length: " + std::to_string(inner.size()) + "\r\n\r\n",
+        "DELETE /api/v1/jobs/0123456789abcdef0123456789abcdef HTTP/1.1\r\nHost: x\r\nRange: items=0-5\r\n"
+        "Content-Length: " + std::to_string(inner.size()) + "\r\n\r\n"}) {
+    CAPTURE(head);
+    const std::string answer = raw_exchange(d.port(), head + inner, 10);
+    INFO(answer);
+    CHECK(answer.find("remeshd_http_requests_total") == std::string::npos);  // /metrics not served
+    CHECK(answer.find("\r\nConnection: close\r\n") != std::string::npos);
+  }
 
   // A Transfer-Encoding other than chunked: at once (it waited for the end of the connection, 30 s,
   // then said 400): 400 when chunked is not the last coding, 501 for a coding before it (RFC 9112
   // 6.1, 6.3). The coding's case does not matter.
   for (const auto& [coding, status] : {std::pair{"gzip", "400"}, std::pair{"chunked, identity", "400"},
-                                       std::pair{"gzip, chunked", "501"}, std::pair{"Chunked", "404"}}) {
+                                       std::pair{"gzip, chunked", "501"}, std::pair{"Chunked", "404"},
+                                       std::pair{"chunked,", "400"}, std::pair{" chunked ", "404"}}) {
     CAPTURE(coding);
     const auto t0 = std::chrono::steady_clock::now();
     const std::string answer = raw_exchange(
