@@ -1,5 +1,7 @@
 #include "io_test_util.h"
 
+#include <catch2/catch.hpp>
+
 #include <algorithm>
 #include <cmath>
 #include <cstring>
@@ -193,6 +195,18 @@ std::string check_loaded(const TriMesh& mesh) {
     if (mesh.is_boundary(mesh.halfedge_handle(e, 0)) && mesh.is_boundary(mesh.halfedge_handle(e, 1)))
       return "edge without faces";
   return "";
+}
+
+void check_same_mesh(const LoadedMesh& got, const LoadedMesh& want) {
+  REQUIRE(got.mesh.n_vertices() == want.mesh.n_vertices());
+  REQUIRE(got.mesh.n_faces() == want.mesh.n_faces());
+  for (auto v : want.mesh.vertices()) CHECK(got.mesh.point(v) == want.mesh.point(v));
+  for (auto f : want.mesh.faces()) {
+    std::vector<int> a, b;
+    for (auto v : got.mesh.fv_range(f)) a.push_back(v.idx());
+    for (auto v : want.mesh.fv_range(f)) b.push_back(v.idx());
+    CHECK(a == b);
+  }
 }
 
 }  // namespace remesh::test

@@ -40,4 +40,8 @@ bool zero_area(const Vec3& a, const Vec3& b, const Vec3& c);
 /// used, each edge with one or two faces, normals set. Otherwise the first problem.
 std::string check_loaded(const TriMesh& mesh);
 
+/// Checks (Catch2) that `got` has the same points as `want`, in order, and the same faces, vertex
+/// by vertex.
+void check_same_mesh(const LoadedMesh& got, const LoadedMesh& want);
+
 }  // namespace remesh::test

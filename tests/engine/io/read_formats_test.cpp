@@ -59,19 +59,6 @@ std::string cube_off(const std::string& header, const std::array<std::string, 2>
 
 const std::string kCubeOff = cube_off("OFF\n8 6 12\n", {" ", " "}, {" ", " ", " ", " "});
 
-/// The same points, in order, and the same faces, vertex by vertex.
-void check_same_mesh(const LoadedMesh& got, const LoadedMesh& want) {
-  REQUIRE(got.mesh.n_vertices() == want.mesh.n_vertices());
-  REQUIRE(got.mesh.n_faces() == want.mesh.n_faces());
-  for (auto v : want.mesh.vertices()) CHECK(got.mesh.point(v) == want.mesh.point(v));
-  for (auto f : want.mesh.faces()) {
-    std::vector<int> a, b;
-    for (auto v : got.mesh.fv_range(f)) a.push_back(v.idx());
-    for (auto v : want.mesh.fv_range(f)) b.push_back(v.idx());
-    CHECK(a == b);
-  }
-}
-
 /// The message of the MeshError that reading `bytes` throws ("" if it reads).
 std::string read_error(const std::string& bytes) {
   try {
@@ -106,7 +93,7 @@ TEST_CASE("OBJ: a comment from '#' may end any line, a face's too") {
   for (std::size_t at = 0, end; (end = kCubeObj.find("\r\n", at)) != std::string::npos; at = end + 2)
     commented += kCubeObj.substr(at, end - at) + (++n % 2 ? "   # c 1 2\r\n" : "#c\r\n");
   REQUIRE(n == 26);
-  check_same_mesh(read_as(commented), read_as(kCubeObj));
+  test::check_same_mesh(read_as(commented), read_as(kCubeObj));
   const std::string tetra = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2 # c\nf 1 2 4\t#\nf 2 3 4#4\nf 1 4 3 #\n";
   CHECK(read_as(tetra).mesh.n_faces() == 4);
 }
@@ -235,7 +222,7 @@ TEST_CASE("OFF: records wrapped over lines read as the one-record-per-line file"
     LoadedMesh wrapped;
     REQUIRE_NOTHROW(wrapped = read_as(text));
     CHECK(wrapped.format == Format::Off);
-    check_same_mesh(wrapped, plain);
+    test::check_same_mesh(wrapped, plain);
   }
 }
 
@@ -244,10 +231,10 @@ TEST_CASE("OFF: extra values after a wrapped record's last value stay ignored") 
   // COFF colours after the 3rd coordinate, a face colour after the last index, on the line where
   // the record completes.
   const std::string coff = cube_off("COFF\n8 6 12\n", {"\n", " "}, {" ", "\n", " ", "\n"}, " 0.5 0.25 1 1\n");
-  check_same_mesh(read_as(coff), plain);
+  test::check_same_mesh(read_as(coff), plain);
   // NOFF normals on the completing line.
   const std::string noff = cube_off("NOFF\n8 6 12\n", {" ", "\n"}, {"\n", " ", " ", " "}, " 0 0 1\n");
-  check_same_mesh(read_as(noff), plain);
+  test::check_same_mesh(read_as(noff), plain);
 }
 
 TEST_CASE("OFF: files read before wrapping was accepted read the same") {
@@ -267,7 +254,7 @@ TEST_CASE("OFF: files read before wrapping was accepted read the same") {
     CAPTURE(what, text);
     LoadedMesh m;
     REQUIRE_NOTHROW(m = read_as(text));
-    check_same_mesh(m, plain);
+    test::check_same_mesh(m, plain);
   }
   // The tetrahedron with a face colour of one value on a face of three: 4 faces, not a 4-gon.
   const LoadedMesh t = read_as("OFF\n4 4 6\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1 7\n3 0 1 3\n3 0 3 2\n3 1 2 3\n");

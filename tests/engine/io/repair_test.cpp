@@ -517,16 +517,7 @@ TEST_CASE("A text file's last line needs no line break, and OFF and PLY cut shor
     for (const std::string end : {"", "\r", " \t"}) {
       const std::string unended = text.substr(0, text.size() - 1) + end;
       CAPTURE(unended);
-      const LoadedMesh got = read(unended);
-      REQUIRE(got.mesh.n_vertices() == want.mesh.n_vertices());
-      REQUIRE(got.mesh.n_faces() == want.mesh.n_faces());
-      for (auto v : want.mesh.vertices()) CHECK(got.mesh.point(v) == want.mesh.point(v));
-      for (auto f : want.mesh.faces()) {
-        std::vector<int> a, b;
-        for (auto v : got.mesh.fv_range(f)) a.push_back(v.idx());
-        for (auto v : want.mesh.fv_range(f)) b.push_back(v.idx());
-        CHECK(a == b);
-      }
+      test::check_same_mesh(read(unended), want);
     }
   }
   CHECK_NOTHROW(read(obj + "# trailing comment without a line break"));
