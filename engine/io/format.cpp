@@ -100,9 +100,9 @@ std::optional<Format> detect_format(std::string_view bytes) {
     if (84 + 50 * n == bytes.size()) return Format::Stl;
   }
   // ASCII STL's first word in any case ("SOLID" from some exporters; read_stl.cpp reads it so).
-  std::string head(text.substr(0, 6));  // the word and what follows it
-  for (char& c : head) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  if (starts_with_word(head, "solid")) return Format::Stl;
+  if (io::is_word_in_any_case(text.substr(0, 5), "solid") &&
+      (text.size() == 5 || io::is_space(text[5]) || text[5] == '\n'))
+    return Format::Stl;
   if (looks_like_obj(text)) return Format::Obj;
   return std::nullopt;
 }

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <bit>
+#include <cctype>
 #include <charconv>
 #include <cmath>
 #include <cstdint>
@@ -45,6 +46,15 @@ class LineScanner {
 };
 
 inline bool is_space(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\f' || c == '\v'; }
+
+/// Is `tok` the lower-case `word` in any case ("SOLID" is "solid": ASCII STL keywords, which some
+/// exporters write in upper case)?
+inline bool is_word_in_any_case(std::string_view tok, std::string_view word) {
+  if (tok.size() != word.size()) return false;
+  for (std::size_t i = 0; i < tok.size(); ++i)
+    if (std::tolower(static_cast<unsigned char>(tok[i])) != word[i]) return false;
+  return true;
+}
 
 /// Cuts the next whitespace-separated token off the front of `s`; false if none is left.
 inline bool next_token(std::string_view& s, std::string_view& token) {

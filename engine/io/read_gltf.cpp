@@ -137,9 +137,9 @@ class Collector {
     // A flat scene visits each node once; a hierarchy that shares subtrees may visit one node
     // exponentially often (each level referencing the next twice): bounded here, and its
     // triangles by max_triangles_. (A flat scene of over 100 000 nodes was refused as a cycle.)
-    if (++visits_ > std::max<std::size_t>(kMinVisits, 4 * model_.nodes.size()))
-      fail("glTF: the scene visits its nodes more than " + std::to_string(std::max<std::size_t>(kMinVisits, 4 * model_.nodes.size())) +
-           " times (subtrees shared too often)");
+    const std::size_t max_visits = std::max<std::size_t>(kMinVisits, 4 * model_.nodes.size());
+    if (++visits_ > max_visits)
+      fail("glTF: the scene visits its nodes more than " + std::to_string(max_visits) + " times (subtrees shared too often)");
     const tinygltf::Node& n = model_.nodes[static_cast<std::size_t>(index)];
     const Mat4 m = multiply(parent, local_transform(n));
     if (n.mesh >= 0) mesh(n.mesh, m);

@@ -3,7 +3,6 @@
 /// (part of reading the format, not a repair). Binary is recognised by its size (84 + 50 n bytes),
 /// even when its header starts with "solid".
 
-#include <cctype>
 #include <cstring>
 #include <string>
 #include <unordered_map>
@@ -77,20 +76,12 @@ RawSoup read_binary_stl(std::string_view bytes, const ReadOptions& options) {
   return soup;
 }
 
-/// ASCII STL's keywords in any case: the format's spec writes them in lower case, but some exporters
-/// write "SOLID", "FACET NORMAL", ... (such a file was taken for a binary one of 1.3 billion
-/// triangles).
-bool is_keyword(std::string_view tok, std::string_view keyword) {
-  if (tok.size() != keyword.size()) return false;
-  for (std::size_t i = 0; i < tok.size(); ++i)
-    if (std::tolower(static_cast<unsigned char>(tok[i])) != keyword[i]) return false;
-  return true;
-}
-
 [[noreturn]] void fail_at(std::size_t line, const std::string& what) {
   fail("ASCII STL line " + std::to_string(line) + ": " + what);
 }
 
+/// Keywords in any case: the format's spec writes them in lower case, but some exporters write
+/// "SOLID", "FACET NORMAL", ... (such a file was taken for a binary one of 1.3 billion triangles).
 RawSoup read_ascii_stl(std::string_view bytes, const ReadOptions& options) {
   RawSoup soup;
   Welder welder(soup);
@@ -102,13 +93,13 @@ RawSoup read_ascii_stl(std::string_view bytes, const ReadOptions& options) {
     std::string_view rest = line;
     if (!next_token(rest, tok)) continue;
     const std::size_t ln = lines.line_number();
-    if (is_keyword(tok, "outer")) {
+    if (is_word_in_any_case(tok, "outer")) {
       if (in_loop) fail_at(ln, "'outer loop' inside another loop");
       in_loop = true;
       corners = 0;
       check_face_limit(soup.face_count() + 1, options, "STL");
       soup.face_lines.push_back(static_cast<std::uint32_t>(ln));
-    } else if (is_keyword(tok, "vertex")) {
+    } else if (is_word_in_any_case(tok, "vertex")) {
       if (!in_loop) fail_at(ln, "'vertex' outside 'outer loop'");
       double c[3];
       for (double& v : c) {
@@ -117,13 +108,14 @@ RawSoup read_ascii_stl(std::string_view bytes, const ReadOptions& options) {
       }
       soup.indices.push_back(welder.add(Vec3(c[0], c[1], c[2]), static_cast<std::uint32_t>(ln)));
       ++corners;
-    } else if (is_keyword(tok, "endloop")) {
+    } else if (is_word_in_any_case(tok, "endloop")) {
       if (!in_loop) fail_at(ln, "'endloop' without 'outer loop'");
       in_loop = false;
       soup.offsets.push_back(static_cast<std::uint32_t>(soup.indices.size()));
-    } else if (is_keyword(tok, "endsolid")) {
+    } else if (is_word_in_any_case(tok, "endsolid")) {
       ended = true;
-    } else if (!is_keyword(tok, "solid") && !is_keyword(tok, "facet") && !is_keyword(tok, "endfacet")) {
+    } else if (!is_word_in_any_case(tok, "solid") && !is_word_in_any_case(tok, "facet") &&
+               !is_word_in_any_case(tok, "endfacet")) {
       fail_at(ln, "unexpected keyword " + quote(tok));
     }
   }
@@ -147,7 +139,7 @@ RawSoup read_stl(std::string_view bytes, const ReadOptions& options) {
   // ASCII STL holds no NUL byte; a binary one whose header starts with "solid" (many exporters
   // write one) almost always does, in its counts and coordinates: a truncated binary file is then
   // reported as binary, with its size, not as ASCII without 'endsolid'.
-  if (is_keyword(text.substr(0, 5), "solid") && bytes.find('\0') == std::string_view::npos)
+  if (is_word_in_any_case(text.substr(0, 5), "solid") && bytes.find('\0') == std::string_view::npos)
     return read_ascii_stl(text, options);
   return read_binary_stl(bytes, options);
 }
