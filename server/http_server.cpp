@@ -182,6 +182,13 @@ void close_after(const httplib::Request& req, httplib::Response& res) {
   };
 }
 
+/// The body's length as the access log gives it: a provided body (files, results, close_after) has
+/// no bytes in res.body, only its Content-Length (the log said 0 for every download); a chunked
+/// one (the event stream) has neither, and counts 0.
+std::size_t body_bytes(const httplib::Response& res) {
+  return res.body.empty() && res.content_provider_ ? res.content_length_ : res.body.size();
+}
+
 /// Does the request carry a body? Without Content-Length and Transfer-Encoding it has none (RFC
 /// 9112 6.3), and cpp-httplib 0.11's reader would wait for one until the client closed or the
 /// read timed out (30 s).
@@ -471,7 +478,7 @@ void HttpServer::Impl::setup() {
     metrics.observe_request(req.method, route, res.status, secs);
     log.info("request", {str("method", req.method), str("path", req.path), str("route", route),
                          num("status", res.status), num("ms", std::round(secs * 1e5) / 100),
-                         num("bytes", static_cast<double>(res.body.size())), str("remote", req.remote_addr)});
+                         num("bytes", static_cast<double>(body_bytes(res))), str("remote", req.remote_addr)});
   });
 
   const std::string jobs_path = std::string(kPrefix) + "/jobs";

@@ -142,6 +142,11 @@ class Collector {
       fail("glTF: the scene visits its nodes more than " + std::to_string(max_visits) + " times (subtrees shared too often)");
     const tinygltf::Node& n = model_.nodes[static_cast<std::size_t>(index)];
     const Mat4 m = multiply(parent, local_transform(n));
+    // Said here, not as a vertex of the soup: a transform that overflows (scales of 1e200 on two
+    // levels) or holds a NaN makes every point of its meshes non-finite.
+    if (n.mesh >= 0 && !std::all_of(m.begin(), m.end(), [](double x) { return std::isfinite(x); }))
+      fail("glTF: node " + std::to_string(index) +
+           "'s transform (its matrix, translation, rotation or scale, times its parents') is not finite");
     if (n.mesh >= 0) mesh(n.mesh, m);
     for (int child : n.children) node(child, m, depth + 1);
   }
@@ -184,6 +189,12 @@ class Collector {
       }
       Vec3 p;
       for (int r = 0; r < 3; ++r) p[r] = m[r] * c[0] + m[4 + r] * c[1] + m[8 + r] * c[2] + m[12 + r];
+      if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2])) {
+        char coords[96];
+        std::snprintf(coords, sizeof coords, "(%g, %g, %g)", c[0], c[1], c[2]);
+        fail("glTF: " + what + " POSITION element " + std::to_string(i) + " " + coords +
+             " is past the range of double once its node's transform is applied");
+      }
       soup_.points.push_back(p);
     }
     std::vector<std::int64_t> idx;

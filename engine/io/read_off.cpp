@@ -92,7 +92,8 @@ RawSoup read_off_binary(std::string_view bytes, std::size_t data_start, const Re
   for (std::int64_t f = 0; f < nf; ++f) {
     if (!r.has(4)) fail("binary OFF: truncated at face " + std::to_string(f) + " of " + std::to_string(nf));
     std::int64_t n = r.read<std::int32_t>(true);
-    if (n < 0 || !r.has(static_cast<std::uint64_t>(n) * 4 + 4))
+    if (n < 0) fail("binary OFF: face " + std::to_string(f) + " has a negative vertex count " + std::to_string(n));
+    if (!r.has(static_cast<std::uint64_t>(n) * 4 + 4))
       fail("binary OFF: face " + std::to_string(f) + " declares " + std::to_string(n) +
            " vertices but the file ends first");
     for (std::int64_t k = 0; k < n; ++k) soup.indices.push_back(r.read<std::int32_t>(true));
@@ -161,6 +162,17 @@ RawSoup read_records(LineScanner lines, std::int64_t nv, std::int64_t nf) {
       wrapped = "face " + std::to_string(f) + " at line " + std::to_string(ln);
     soup.offsets.push_back(static_cast<std::uint32_t>(soup.indices.size()));
     soup.face_lines.push_back(static_cast<std::uint32_t>(ln));
+  }
+  // Content after the declared faces is not read, but said: a face count too small in the header
+  // drops the faces past it (the mesh then has holes there), which the reader used to do silently.
+  if (tokens.start()) {
+    const std::size_t first = tokens.line();
+    std::size_t extra = 1;
+    while (tokens.start()) ++extra;
+    soup.repairs.push_back({"off_lines_after_faces_ignored", extra,
+                            std::to_string(extra) + (extra == 1 ? " content line" : " content lines") + " after the " +
+                                std::to_string(nf) + " faces the header declares ignored, from line " +
+                                std::to_string(first) + " (is the header's face count too small?)"});
   }
   return soup;
 }

@@ -10,6 +10,7 @@
 #include <regex>
 #include <set>
 #include <sstream>
+#include <thread>
 #include <tuple>
 
 #include "api/json_codec.h"
@@ -546,6 +547,24 @@ TEST_CASE("remeshd: parameters and names that once crashed the service or gave 5
   REQUIRE(part);
   CHECK(part->status == 206);
   CHECK(part->body == whole->body.substr(0, 100));
+  // The access log counts the bytes sent, provided bodies included (it said bytes=0 for both). The
+  // line is written once the answer is out: waited for.
+  {
+    const std::string route = "path=/api/v1/jobs/" + big_id + "/result ";
+    auto logged = [&](const std::string& fields) {
+      for (int tries = 0; tries < 200; ++tries) {
+        std::istringstream lines(d.log());
+        for (std::string line; std::getline(lines, line);)
+          if (line.find(route) != std::string::npos && line.find(fields) != std::string::npos) return true;
+        std::this_thread::sleep_for(std::chrono::milliseconds(10));
+      }
+      return false;
+    };
+    CHECK(logged("status=200 ms="));
+    CHECK(logged(" bytes=" + std::to_string(whole->body.size()) + " "));
+    CHECK(logged("status=206 ms="));
+    CHECK(logged(" bytes=100 "));
+  }
   // Ranges past the end: never a byte past the file (cpp-httplib served them unclipped from the
   // heap), a whole answer when the range covers it, 416 when it starts past the end.
   const std::size_t size = whole->body.size();

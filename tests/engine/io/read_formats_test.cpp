@@ -1,6 +1,7 @@
 // Reading each input format, with the format-specific details the readers must handle.
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <array>
 #include <cctype>
 #include <vector>
@@ -67,6 +68,21 @@ std::string read_error(const std::string& bytes) {
     return e.what();
   }
   return "";
+}
+
+/// The unit square's four corners (0,0,0) (1,0,0) (0,1,0) (1,1,0) as float32, base64 (48 bytes -> 64
+/// characters): a glTF buffer for a strip or a fan.
+std::string unit_square_base64() {
+  std::string bin;
+  auto put_f = [&](float v) { bin.append(reinterpret_cast<const char*>(&v), 4); };
+  for (float v : {0.f, 0.f, 0.f, 1.f, 0.f, 0.f, 0.f, 1.f, 0.f, 1.f, 1.f, 0.f}) put_f(v);
+  static const char* t = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  std::string b64;
+  for (std::size_t i = 0; i < bin.size(); i += 3) {
+    unsigned v = (unsigned char)bin[i] << 16 | (unsigned char)bin[i + 1] << 8 | (unsigned char)bin[i + 2];
+    b64 += {t[v >> 18], t[(v >> 12) & 63], t[(v >> 6) & 63], t[v & 63]};
+  }
+  return b64;
 }
 
 }  // namespace
@@ -191,6 +207,31 @@ TEST_CASE("OFF: ASCII with comments, colours and counts on the header line, bina
   CHECK(b.format == Format::Off);
   CHECK(b.mesh.n_faces() == 80);
   CHECK(b.repairs.empty());
+}
+
+TEST_CASE("OFF: content after the declared faces is reported as ignored, a negative binary face size named") {
+  const LoadedMesh plain = read_as(kCubeOff);
+  // Two more faces than the header's 6, a comment and a blank line among them: the 12 are read,
+  // the rest is said (it was dropped silently, holes and all).
+  const LoadedMesh m = read_as(kCubeOff + "# two more\n3 0 1 2\n\n3 4 5 6 0.5\n");
+  test::check_same_mesh(m, plain);
+  // The cube's quads are triangulated (one repair); the lines after its faces are the other.
+  REQUIRE(m.repairs.size() == plain.repairs.size() + 1);
+  const Repair& ignored = m.repairs.front();
+  CHECK(ignored.kind == "off_lines_after_faces_ignored");
+  CHECK(ignored.count == 2);
+  const std::size_t cube_lines = static_cast<std::size_t>(std::count(kCubeOff.begin(), kCubeOff.end(), '\n'));
+  CHECK(ignored.detail == "2 content lines after the 6 faces the header declares ignored, from line " +
+                              std::to_string(cube_lines + 2) + " (is the header's face count too small?)");
+  // Comments and blank lines alone after the faces are nothing to report.
+  CHECK(read_as(kCubeOff + "# end\n\n  \n").repairs.size() == plain.repairs.size());
+
+  // Binary: a face whose vertex count is negative is named as such (it said the file ended first).
+  std::string bin = test::write_off_binary(to_soup(test::make_icosphere(0)));
+  const std::size_t face0 = std::string("OFF BINARY\n").size() + 12 + 12 * 12;  // header, counts, 12 points
+  const unsigned char minus_three[4] = {0xff, 0xff, 0xff, 0xfd};  // big-endian int32 -3
+  bin.replace(face0, 4, reinterpret_cast<const char*>(minus_three), 4);
+  CHECK(read_error(bin) == "binary OFF: face 0 has a negative vertex count -3");
 }
 
 TEST_CASE("OFF: records wrapped over lines read as the one-record-per-line file") {
@@ -352,17 +393,7 @@ TEST_CASE("glTF: data URI buffer and GLB") {
 
 TEST_CASE("glTF: node transforms (TRS and matrix, nested), strips, fans and several meshes are merged") {
   // One triangle-strip quad in mesh 0 (used twice: translated and mirrored by a matrix) and a fan in mesh 1.
-  std::string bin;
-  auto put_f = [&](float v) { bin.append(reinterpret_cast<const char*>(&v), 4); };
-  for (float v : {0.f, 0.f, 0.f, 1.f, 0.f, 0.f, 0.f, 1.f, 0.f, 1.f, 1.f, 0.f}) put_f(v);
-  std::string b64;  // tiny base64 encoder, 48 bytes -> 64 chars
-  {
-    static const char* t = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-    for (std::size_t i = 0; i < bin.size(); i += 3) {
-      unsigned v = (unsigned char)bin[i] << 16 | (unsigned char)bin[i + 1] << 8 | (unsigned char)bin[i + 2];
-      b64 += {t[v >> 18], t[(v >> 12) & 63], t[(v >> 6) & 63], t[v & 63]};
-    }
-  }
+  const std::string b64 = unit_square_base64();
   const std::string gltf = R"({"asset":{"version":"2.0"},"scene":0,"scenes":[{"nodes":[0,2]}],
     "nodes":[{"translation":[0,0,5],"children":[1],"mesh":0},
              {"matrix":[-1,0,0,0, 0,1,0,0, 0,0,1,0, 10,0,0,1],"mesh":0},
@@ -389,6 +420,29 @@ TEST_CASE("glTF: node transforms (TRS and matrix, nested), strips, fans and seve
   CHECK(found_mirror);
   CHECK(s.bbox_min[0] == Approx(-2));  // the rotated fan reaches x = -2
   CHECK(s.bbox_max[2] == Approx(5));
+}
+
+TEST_CASE("glTF: a node transform past the range of double is named, not reported as a soup vertex") {
+  // The unit square's strip under a node with a given transform, below a parent scaled by 1e200.
+  auto scene = [](const std::string& child) {
+    return R"({"asset":{"version":"2.0"},"scene":0,"scenes":[{"nodes":[0]}],
+      "nodes":[{"scale":[1e200,1e200,1e200],"children":[1]},)" + child + R"(],
+      "meshes":[{"primitives":[{"attributes":{"POSITION":0},"mode":5}]}],
+      "accessors":[{"bufferView":0,"componentType":5126,"count":4,"type":"VEC3"}],
+      "bufferViews":[{"buffer":0,"byteLength":48}],
+      "buffers":[{"byteLength":48,"uri":"data:application/octet-stream;base64,)" + unit_square_base64() + R"("}]})";
+  };
+  // Scaled by 1e200 again: the product overflows (and 0 * inf is NaN); before, "vertex 0 has a
+  // non-finite coordinate (nan, ...)".
+  CHECK(read_error(scene(R"({"scale":[1e200,1e200,1e200],"mesh":0})")) ==
+        "glTF: node 1's transform (its matrix, translation, rotation or scale, times its parents') is not finite");
+  // A finite transform (1e308 along x, moved 1e308) that a finite point overflows through: the
+  // element and its stored value named.
+  CHECK(read_error(scene(R"({"translation":[1e108,0,0],"scale":[1e108,1,1],"mesh":0})")) ==
+        "glTF: mesh 0 primitive 0 POSITION element 1 (1, 0, 0) is past the range of double once its node's "
+        "transform is applied");
+  // Large but finite: read.
+  CHECK(read_error(scene(R"({"scale":[1e-100,1e-100,1e-100],"mesh":0})")).empty());
 }
 
 TEST_CASE("glTF: a buffer pointing to an external file is refused without reading it") {
