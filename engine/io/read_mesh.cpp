@@ -42,6 +42,10 @@ LoadedMesh read_mesh(std::string_view bytes, const ReadOptions& options) {
     if (sniffed && sniffed != format)
       throw MeshError("read as " + std::string(format_name(*format)) + " (its name or format parameter) it holds " +
                       "no vertices and no faces, but its content looks like " + std::string(format_name(*sniffed)));
+    // Nor is a file with a NUL byte OBJ text: an image or another binary file under an .obj name.
+    if (!sniffed && *format == Format::Obj && bytes.find('\0') != std::string_view::npos)
+      throw MeshError("read as obj (its name or format parameter) it holds no vertices and no faces: its content "
+                      "is binary data, not OBJ text nor any mesh format this reader knows");
   }
   LoadedMesh out{TriMesh(), *format, std::move(soup.repairs)};
   out.mesh = io::build_mesh(std::move(soup), options, out.repairs);

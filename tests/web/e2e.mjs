@@ -316,6 +316,24 @@ async function main() {
   const lens_rows = await (await fetch(`${base}/api/v1/jobs/${lens_id}/stats?format=json`)).json();
   await check_histogram(page, 'remeshed', (Array.isArray(lens_rows) ? lens_rows : lens_rows.rows || []).at(-1));
 
+  // --- a job opened by its address keeps its own interval, and its input's mean becomes the target
+  // (the target of the page's last file stayed, and "Fill" gave an interval for that file) ---
+  const lens_mean = (await (await fetch(`${base}/api/v1/jobs/${lens_id}`)).json()).input.summary.edge_length.mean;
+  const lens_form = { target: +await page.inputValue('#target'), emin: +await page.inputValue('#emin'), emax: +await page.inputValue('#emax') };
+  check(Math.abs(lens_form.target - lens_mean) <= 1e-3 * lens_mean && lens_form.emin === 1 && lens_form.emax === 1.4,
+    `the opened job's input mean is the target, its interval the job's (${JSON.stringify(lens_form)}, mean ${lens_mean})`);
+
+  // --- deleting the watched job from the recent-jobs list clears its panel (its downloads pointed
+  // at files that were gone) ---
+  const delete_button = `#jobs li[data-id="${lens_id}"] button.link`;
+  await page.waitForSelector(delete_button, { timeout: 10000 });
+  page.once('dialog', (d) => d.accept());
+  await page.click(delete_button);
+  const forgotten = await page.waitForFunction(() => document.getElementById('job-state').textContent === 'deleted' &&
+    !document.querySelector('#downloads button') && !/job=/.test(location.hash) &&
+    document.getElementById('show-remeshed').disabled, null, { timeout: 10000 }).then(() => true, () => false);
+  check(forgotten, 'deleting the watched job clears its panel, downloads, 3D choices and address');
+
   // --- a .txt name: no verdict before the server has tried ---
   const txt_path = path.join(tmp, 'sphere.txt');
   fs.writeFileSync(txt_path, icosphere_obj(2));
@@ -411,6 +429,14 @@ async function check_phone(base, job_id, mesh_path, console_errors) {
       `phone, a file chosen: the file chooser, e_min/e_max and Remesh in the first ${H} px with the options folded ` +
       `(bottoms ${form.file.bottom}, ${form.emin.bottom}, ${form.emax.bottom}, Remesh ${form.submit.bottom})`);
     check(form.submit.height >= 40, `phone: Remesh is a touch target at least 40 px high (${form.submit.height} px)`);
+    // Remesh brings the job panel into view: it lies below the form and the job list, and a tap
+    // changed nothing on screen while the job ran unseen 1 200 px further down.
+    await phone.click('#submit');
+    const panel_shown = await phone.waitForFunction(() => {
+      const r = document.querySelector('section.job').getBoundingClientRect();
+      return /job=/.test(location.hash) && r.top >= -1 && r.top < innerHeight / 2;
+    }, null, { timeout: 10000 }).then(() => true, () => false);
+    check(panel_shown, 'phone: Remesh brings the job panel into view');
 
     // The finished job: downloads, 3D view, histogram, charts and its table.
     await phone.evaluate((id) => { location.hash = `job=${id}`; }, job_id);

@@ -573,6 +573,9 @@ TEST_CASE("A file given under another format's name says what its content looks 
   // Read by its content, it is fine; an empty OBJ is still just empty.
   CHECK(read_as(ply).mesh.n_faces() == 20);
   CHECK_THROWS_WITH(read_as("# nothing\n", Format::Obj), Catch::Contains("holds no vertices and no faces"));
+  // An image under a .obj name: binary data, said to be so (it was "no vertices and no faces").
+  const std::string png("\x89PNG\r\n\x1a\n\0\0\0\rIHDR\0\0\0\x10\0\0\0\x10\x08\x06\0\0\0", 33);
+  CHECK_THROWS_WITH(read_as(png, Format::Obj), Catch::Contains("its content is binary data, not OBJ text"));
 }
 
 TEST_CASE("GLB: accessor and bufferView offsets whose sums wrap round 2^64 are refused, not read") {

@@ -89,7 +89,9 @@ async function choose_file(file) {
   for (const name of ['input', 'remeshed', 'dual']) state.viewer?.forget(name);
   set_available(['input']);
   $('show-input').checked = true;
-  params.set_input_mean(NaN);
+  // The last input's target does not carry over ("Fill" gave an interval twice this file's mean);
+  // the preview, if any, fills it and the interval from this file's mean.
+  params.set_input_mean(NaN, '', { clear: true });
   state.input_of = null;
   state.watched = null;
   if (!['obj', 'off', 'ply', 'stl', 'gltf', 'glb'].includes(format_of(file.name))) {
@@ -159,11 +161,16 @@ async function submit(e) {
   clear_file_error();
   const p = params.read_params();
   if (!state.file && view.job) {
-    // Watching a job started elsewhere: run again on its (server-read) input, as GLB.
+    // Watching a job started elsewhere: run again on its (server-read) input, in its own format
+    // where the server writes it (OBJ, OFF and PLY hold the coordinates exactly; GLB has float32,
+    // as a glTF input had), so the new job keeps the input's name (it was renamed .glb).
     try {
-      const res = await api.request(api.result_url(view.job.id, 'input', 'glb'));
-      const stem = (view.job.input?.filename || 'input').replace(/\.[^.]*$/, '');
-      state.file = new File([await res.blob()], `${stem}.glb`, { type: 'model/gltf-binary' });
+      const name = view.job.input?.filename || 'input';
+      const own = format_of(name);
+      const format = ['obj', 'off', 'ply', 'stl', 'glb'].includes(own) ? own : 'glb';
+      const res = await api.request(api.result_url(view.job.id, 'input', format));
+      const file_name = format === own ? name : `${name.replace(/\.[^.]*$/, '')}.glb`;
+      state.file = new File([await res.blob()], file_name);
     } catch (err) {
       $('submit-status').textContent = `Cannot fetch the job's input: ${err.message}`;
       return;
@@ -187,6 +194,7 @@ async function submit(e) {
     state.file_job = job.id;
     location.hash = `job=${encodeURIComponent(job.id)}`;  // hashchange starts watching
     jobs.refresh();  // the new job belongs in the list now, not at the next poll
+    show_job_panel();
   } catch (err) {
     $('submit-status').textContent = '';
     const name = state.file?.name || 'the file';
@@ -211,6 +219,15 @@ async function submit(e) {
   } finally {
     button.disabled = false;
   }
+}
+
+/// On one column (phones, narrow windows) the job panel lies below the form and the job list: it is
+/// brought into view when a job starts (at 390 px a tap on Remesh changed nothing on screen, and
+/// the job ran unseen 1 200 px further down).
+function show_job_panel() {
+  const panel = document.querySelector('section.job');
+  const r = panel.getBoundingClientRect();
+  if (r.top < 0 || r.top > 0.5 * innerHeight) panel.scrollIntoView({ block: 'start', behavior: 'smooth' });
 }
 
 /// The request fields that are about the uploaded file rather than a parameter.
@@ -243,15 +260,18 @@ function readable_numbers(text) { return String(text).replace(/\b\d{5,}\b/g, (d)
 const view = new JobView({
   on_job(job) {
     jobs.set_current(job.id);
+    const first = state.watched !== job.id;
     if (job.input?.summary) {
       show_summary(job.input.summary, `server summary of ${job.input.filename || 'the input'}` +
         (job.input.format ? ` (${job.input.format})` : ''));
       show_repairs(job.input.repairs);
-      params.set_input_mean(job.input.summary.edge_length?.mean, 'server');
+      // A job opened from the list is another input: its mean becomes the target (the interval
+      // stays the job's own, written below).
+      params.set_input_mean(job.input.summary.edge_length?.mean, 'server', { target: first });
     }
     if (job.input?.filename)
       $('file-name').textContent = `${job.input.filename}${job.input.bytes ? ` · ${bytes(job.input.bytes)}` : ''}`;
-    if (state.watched !== job.id) {
+    if (first) {
       state.watched = job.id;
       params.write_params(job.params);
       interval_changed();
@@ -274,7 +294,32 @@ const view = new JobView({
     load_mesh('remeshed', job.id);
   },
 });
-const jobs = new JobsList();
+const jobs = new JobsList({ on_deleted: forget_job });
+
+/// The watched job was deleted (from the recent-jobs list): its panel, meshes and address go, so
+/// that no download or view points at files that are gone ("no job with id ...").
+function forget_job(id) {
+  if (view.job?.id !== id && state.watched !== id) return;
+  view.stop();
+  reset_job_panel();
+  $('job-state').textContent = 'deleted';
+  state.watched = null;
+  state.input_of = null;
+  state.job_state = null;
+  if (state.file_job === id) state.file_job = null;
+  for (const name of ['input', 'remeshed', 'dual']) state.viewer?.forget(name);
+  set_available([]);
+  $('summary').replaceChildren();
+  $('repairs').replaceChildren();
+  if (!state.file) {
+    $('file-name').textContent = '';
+    params.set_input_mean(NaN, '', { clear: true });
+  }
+  status(state.file ? `The job was deleted with its files; Remesh uploads ${state.file.name} again.`
+    : 'The job was deleted with its files. Drop a mesh to start.');
+  if (location.hash) history.replaceState(null, '', location.pathname + location.search);
+  jobs.set_current('');
+}
 
 function reset_job_panel() {
   document.title = 'remeshd';

@@ -6,7 +6,9 @@ import * as api from './api.js';
 const $ = (id) => document.getElementById(id);
 
 export class JobsList {
-  constructor() {
+  /// `on_deleted(id)`: a job was deleted from the list (the page forgets it if it is watched).
+  constructor({ on_deleted } = {}) {
+    this.on_deleted = on_deleted;
     this.timer = null;
     this.current = '';
     this.requests = 0;
@@ -80,8 +82,10 @@ export class JobsList {
         del.setAttribute('aria-label', `Delete job ${job.input?.filename || job.id} and its files`);
         del.addEventListener('click', async () => {
           if (!confirm(`Delete job ${job.id} (${job.input?.filename || ''}) and its files?`)) return;
-          try { await api.delete_job(job.id); } catch (e) { alert(e.message); }
-          if (job.id === this.current && location.hash) location.hash = '';
+          try {
+            await api.delete_job(job.id);
+            this.on_deleted?.(job.id);
+          } catch (e) { alert(e.message); }
           this.refresh();
         });
         links.append(' ', del);

@@ -60,6 +60,10 @@ export function local_errors(p) {
   if (p.emax === undefined) errs.push({ field: 'emax', message: 'is required: enter the longest edge length wanted' });
   else if (!(p.emax > 0)) errs.push({ field: 'emax', message: 'must be a number greater than 0' });
   else if (p.emin > 0 && !(p.emax > p.emin)) errs.push({ field: 'emax', message: 'must be greater than e_min' });
+  // A fraction where a count is wanted, in words (the server's message adds the integer range).
+  for (const name of ['iterations', 'rings', 'relax_every'])
+    if (typeof p[name] === 'number' && !Number.isInteger(p[name]))
+      errs.push({ field: name, message: `must be a whole number, not ${p[name]}` });
   return errs;
 }
 
@@ -180,12 +184,21 @@ export function init_helper(on_change) {
 
 /// Shows the input's mean edge length beside the helper; on a fresh input (or an empty form)
 /// it becomes the target and fills the interval.
-export function set_input_mean(mean, source, { fill = false } = {}) {
+/// With `target`, the mean becomes the target without touching the interval (a job opened from the
+/// list keeps its own); with `clear` (a new input, mean unknown yet), the target is emptied, so
+/// that "Fill" cannot apply the last input's mean to this one (the interval stays as typed: a file
+/// without a preview is still sent, for the server to read or refuse).
+export function set_input_mean(mean, source, { fill = false, target = false, clear = false } = {}) {
   const out = $('input-mean');
   out.dataset.value = mean > 0 ? mean : '';
   out.textContent = mean > 0 ? `${round(mean)} (${source})` : '–';
   $('use-mean').hidden = !(mean > 0);
-  if (mean > 0 && (fill || $('target').value === '')) {
+  if (clear) {
+    $('target').value = '';
+    $('helper-error').textContent = '';
+  }
+  if (mean > 0 && target) $('target').value = round(mean);
+  else if (mean > 0 && (fill || $('target').value === '')) {
     $('target').value = round(mean);
     $('apply-target').click();
   }

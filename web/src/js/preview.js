@@ -37,21 +37,31 @@ class Builder {
   done() {
     const n = this.pos.length / 3;
     for (const i of this.tri) if (!(i >= 0 && i < n)) throw new Error(`face refers to vertex ${i + 1}, but there are ${n}`);
-    if (!this.tri.length) throw new Error('no faces');
+    if (!this.tri.length) throw new Error(this.pos.length ? 'no faces' : 'no vertices and no faces');
     return { positions: Float32Array.from(this.pos), triangles: Uint32Array.from(this.tri), faces: this.faces };
   }
 }
 
+/// Values that are not numbers are named with their line, as the server's reader does (a vertex
+/// line "v a b c" was read as NaN and reported as "face refers to vertex NaN").
 function read_obj(text) {
   const b = new Builder();
-  for (const line of text.split('\n')) {
+  if (text.includes('\0')) throw new Error('binary data, not OBJ text');
+  const lines = text.split('\n');
+  for (let k = 0; k < lines.length; ++k) {
+    const line = lines[k].replace(/#.*/, '');
     if (line.startsWith('v ') || line.startsWith('v\t')) {
-      const p = line.trim().split(/\s+/);
-      b.pos.push(+p[1], +p[2], +p[3]);
+      const p = line.trim().split(/\s+/).slice(1, 4);
+      const c = p.map(Number);
+      if (c.length < 3) throw new Error(`line ${k + 1}: a vertex with fewer than 3 coordinates`);
+      if (!c.every(Number.isFinite))
+        throw new Error(`line ${k + 1}: bad vertex coordinate "${p.find((t, i) => !Number.isFinite(c[i]))}"`);
+      b.pos.push(...c);
     } else if (line.startsWith('f ') || line.startsWith('f\t')) {
       const n = b.pos.length / 3;
       const ids = line.trim().split(/\s+/).slice(1).map((t) => {
         const i = parseInt(t, 10);
+        if (!Number.isInteger(i)) throw new Error(`line ${k + 1}: bad face index "${t}"`);
         return i < 0 ? n + i : i - 1;
       });
       b.face(ids);
