@@ -121,10 +121,6 @@ export class IterationChart {
       const yy = Math.round(y(m.value)) + 0.5;
       ctx.beginPath(); ctx.moveTo(pad.l, yy); ctx.lineTo(w - pad.r, yy); ctx.stroke();
       ctx.setLineDash([]);
-      ctx.fillStyle = css(m.color);
-      ctx.textAlign = 'left';
-      ctx.textBaseline = 'bottom';
-      ctx.fillText(m.label, pad.l + 3, yy - 1);
     }
 
     for (const s of this.series) {
@@ -152,6 +148,18 @@ export class IterationChart {
       if (rows.length === 1 && started) {
         ctx.beginPath(); ctx.arc(x(rows[0].iteration), y(s.key(rows[0])), 2.5, 0, 7); ctx.fill();
       }
+    }
+    // The reference lines' labels over the curves, on a patch of the panel's colour (drawn under
+    // them, the mean's curve ran through "e_min").
+    ctx.textAlign = 'left';
+    ctx.textBaseline = 'bottom';
+    for (const m of marks) {
+      const yy = Math.round(y(m.value)) + 0.5;
+      const tw = ctx.measureText(m.label).width;
+      ctx.fillStyle = css('--panel');
+      ctx.fillRect(pad.l + 1, yy - 13, tw + 4, 12);
+      ctx.fillStyle = css(m.color);
+      ctx.fillText(m.label, pad.l + 3, yy - 1);
     }
     // Legend, top right.
     ctx.textAlign = 'right';
