@@ -83,6 +83,15 @@ Args parse_args(const std::vector<std::string>& args, const std::vector<OptionSp
       out.set(name, *inline_value);
     } else {
       if (i + 1 >= args.size()) throw UsageError("option '--" + name + "' needs a value (" + it->value_name + ")");
+      // An option where the value should be is a value left out, not the value: "--dual --stats
+      // s.csv" said "unexpected argument 's.csv'", and "--emin --emax 0.3" that --emax was missing.
+      // (A value that starts with "--" is given as --name=value.)
+      const std::string& next = args[i + 1];
+      if (next.rfind("--", 0) == 0) {
+        const std::string next_name = next.substr(2, next.find('=') == std::string::npos ? std::string::npos : next.find('=') - 2);
+        if (next == "--" || std::any_of(spec.begin(), spec.end(), [&](const OptionSpec& s) { return s.name == next_name; }))
+          throw UsageError("option '--" + name + "' needs a value (" + it->value_name + "), but is followed by '" + next + "'");
+      }
       out.set(name, args[++i]);
     }
   }

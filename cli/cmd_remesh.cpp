@@ -51,7 +51,7 @@ const std::vector<OptionSpec> kSpec = {
     {"relax-dual", "", "relax the dual's bonds toward the middle of [A, B] / sqrt(3) (atom lattices); needs --dual"},
     {"stats", "FILE", "write the per-iteration statistics to FILE.csv or FILE.json"},
     {"threads", "T", "worker threads; 0 = all cores (default 0; results do not depend on it)"},
-    {"max-faces", "N", "refuse inputs and estimated outputs over N faces; 0 = no limit (default 20000000)"},
+    {"max-faces", "N", "refuse runs whose estimated output exceeds N faces (default 20000000), and, when given, inputs over N faces; 0 = no limit"},
     {"weld", "", "weld duplicate vertices at the same position while reading"},
     {"quiet", "", "print nothing but errors"},
 };

@@ -152,6 +152,12 @@ TEST_CASE("bad arguments exit with 2 and one line on stderr", "[cli]") {
   cases.push_back({{mesh, out, "--emin", "0.2", "--emax", "0.3", "--iterations", "5000000000"}, "far too large"});
   cases.push_back({{mesh, out, "--emin", "0.2", "--emax", "0.3", "--rings", "99999999999999999999"}, "far too large"});
   cases.push_back({{mesh, out, "--emin", "0.2", "--emax", "0.3", "--threads", "4097"}, "outside 0..1024"});
+  // An option where a value should be: the value was left out (it said "unexpected argument
+  // 's.csv'", or that --emax was missing when it was given).
+  cases.push_back({{mesh, out, "--emin", "0.2", "--emax", "0.3", "--dual", "--stats", dir.file("s.csv")},
+                   "option '--dual' needs a value (DUAL_OUT), but is followed by '--stats'"});
+  cases.push_back({{mesh, out, "--emin", "--emax", "0.3"}, "option '--emin' needs a value"});
+  cases.push_back({{mesh, out, "--emin", "0.2", "--emax", "0.3", "--dual", "--relax-dual"}, "followed by '--relax-dual'"});
   // A name longer than the file system takes (a long one it takes is written: the probe was
   // named after it, and too long itself).
   cases.push_back({{"convert", mesh, dir.file(std::string(300, 'a') + ".obj")}, "output file name too long"});
