@@ -287,6 +287,7 @@ const view = new JobView({
       jobs.refresh();
     }
   },
+  on_progress(job, done, total) { jobs.set_progress(job.id, done, total); },
   on_end(job) {
     if (job.state !== 'succeeded') return;
     set_available(['input', 'remeshed', 'dual']);

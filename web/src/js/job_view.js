@@ -45,7 +45,8 @@ export function dual_text(d) {
 }
 
 export class JobView {
-  /// hooks: on_job(job) after every document refresh, on_end(job) once when the job is final.
+  /// hooks: on_job(job) after every document refresh, on_end(job) once when the job is final,
+  /// on_progress(job, done, total) whenever the progress line is drawn (rows as they arrive).
   constructor(hooks) {
     this.hooks = hooks;
     this.job = null;
@@ -250,6 +251,7 @@ export class JobView {
     const bar = $('progress');
     bar.max = Math.max(total, 1);
     bar.value = job.state === 'succeeded' ? bar.max : Math.min(done, bar.max);
+    this.hooks.on_progress?.(job, done, total);
     let text = `iteration ${done} of ${total}`;
     if (job.state === 'succeeded' && done < total) text += ' (stopped early)';
     if (job.outcome) text += ` · ${typeof job.outcome === 'string' ? job.outcome : JSON.stringify(job.outcome)}`;

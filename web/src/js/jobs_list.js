@@ -19,6 +19,17 @@ export class JobsList {
     document.addEventListener('visibilitychange', () => { if (!document.hidden) this.refresh(); });
   }
 
+  /// The watched job's iterations as its rows arrive (the list polls every 3 s: it showed 0/200
+  /// while the job panel was at iteration 46).
+  set_progress(id, done, total) {
+    const meta = [...$('jobs').children].find((li) => li.dataset.id === id)?.querySelector('.meta');
+    if (!meta?.dataset.parts || !total) return;
+    const parts = JSON.parse(meta.dataset.parts);
+    parts[2] = `${done}/${total} it`;
+    meta.dataset.parts = JSON.stringify(parts);
+    meta.textContent = parts.filter(Boolean).join(' · ');
+  }
+
   set_current(id) {
     this.current = id;
     for (const li of $('jobs').children) li.classList.toggle('current', li.dataset.id === id);
@@ -69,9 +80,10 @@ export class JobsList {
       meta.className = 'meta';
       const p = job.progress || {};
       const v = job.input?.summary?.vertices;
-      meta.textContent = [job.id.slice(0, 8), when(job.created_at),
-        p.iterations ? `${p.iteration ?? 0}/${p.iterations} it` : '', v ? `${v.toLocaleString()} v` : '']
-        .filter(Boolean).join(' · ');
+      const parts = [job.id.slice(0, 8), when(job.created_at),
+        p.iterations ? `${p.iteration ?? 0}/${p.iterations} it` : '', v ? `${v.toLocaleString()} v` : ''];
+      meta.dataset.parts = JSON.stringify(parts);
+      meta.textContent = parts.filter(Boolean).join(' · ');
       const links = document.createElement('span');
       links.append(events);
       if (['succeeded', 'failed', 'cancelled'].includes(job.state)) {
