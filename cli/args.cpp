@@ -88,7 +88,8 @@ Args parse_args(const std::vector<std::string>& args, const std::vector<OptionSp
       // (A value that starts with "--" is given as --name=value.)
       const std::string& next = args[i + 1];
       if (next.rfind("--", 0) == 0) {
-        const std::string next_name = next.substr(2, next.find('=') == std::string::npos ? std::string::npos : next.find('=') - 2);
+        std::string next_name = next.substr(2);
+        next_name.resize(std::min(next_name.size(), next_name.find('=')));
         if (next == "--" || std::any_of(spec.begin(), spec.end(), [&](const OptionSpec& s) { return s.name == next_name; }))
           throw UsageError("option '--" + name + "' needs a value (" + it->value_name + "), but is followed by '" + next + "'");
       }
