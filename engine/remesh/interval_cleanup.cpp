@@ -767,17 +767,26 @@ void PatchRest::begin() {
   ++cleanup_;
 }
 
+std::uint32_t PatchRest::rest_after(std::uint32_t row) {
+  return row < kRow ? 0 : std::uint32_t{1} << std::min(row - kRow, kMaxRestShift);
+}
+
 bool PatchRest::resting(VertexHandle a, VertexHandle b) const {
-  const std::uint32_t before = cleanup_ - 1;
-  const Failures &x = mesh_.property(at_, a), &y = mesh_.property(at_, b);
-  return before > 0 && x.at == before && y.at == before && x.row >= kRow && y.row >= kRow;
+  // Each end failed in one of the last rest_after(its row) cleanups, not in this one.
+  auto rests = [this](const Failures& f) {
+    return f.at > 0 && f.at < cleanup_ && cleanup_ - f.at <= rest_after(f.row);
+  };
+  return rests(mesh_.property(at_, a)) && rests(mesh_.property(at_, b));
 }
 
 void PatchRest::failed(VertexHandle a, VertexHandle b) {
   for (auto v : {a, b}) {
     Failures& f = mesh_.property(at_, v);
     if (f.at == cleanup_) continue;
-    f.row = f.at > 0 && cleanup_ - f.at <= 2 ? f.row + 1 : 1;  // at most two apart: the row goes on
+    // The row goes on when this failure comes right after the rest the last one gave (at most two
+    // apart before a rest of more than one cleanup).
+    const std::uint32_t within = std::max<std::uint32_t>(2, rest_after(f.row) + 1);
+    f.row = f.at > 0 && cleanup_ - f.at <= within ? f.row + 1 : 1;
     f.at = cleanup_;
   }
 }

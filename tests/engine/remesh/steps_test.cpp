@@ -1026,7 +1026,7 @@ TEST_CASE("the cleanup's failure memory changes nothing but the work", "[steps]"
   CHECK(skipped > 0);  // the memory was used
 }
 
-TEST_CASE("a patch relaxation that failed in two cleanups in a row rests for one", "[steps]") {
+TEST_CASE("a patch relaxation that failed in two cleanups in a row rests for one, longer as the row goes on", "[steps]") {
   // The memory alone: an edge whose ends both had failures in the last two cleanups (a rest
   // between two does not break the row) rests in the next cleanup, then is tried again; a failure
   // at one end rests nothing; a mesh rebuilt from scratch starts afresh.
@@ -1057,6 +1057,29 @@ TEST_CASE("a patch relaxation that failed in two cleanups in a row rests for one
     CHECK(rest.resting(a, b));
     rest.begin();  // 6
     rest.begin();  // 7: nothing failed in 6
+    CHECK_FALSE(rest.resting(a, b));
+    // A row that goes on rests longer: after the third failure in a row (4, failed again at 7,
+    // right after its rest of 2), 4 cleanups; after the fourth, 8, the longest.
+    rest.failed(a, b);
+    for (int cleanup = 8; cleanup <= 11; ++cleanup) {
+      CAPTURE(cleanup);
+      rest.begin();
+      CHECK(rest.resting(a, b));
+    }
+    rest.begin();  // 12
+    CHECK_FALSE(rest.resting(a, b));
+    rest.failed(a, b);
+    for (int cleanup = 13; cleanup <= 20; ++cleanup) {
+      CAPTURE(cleanup);
+      rest.begin();
+      CHECK(rest.resting(a, b));
+    }
+    rest.begin();  // 21
+    CHECK_FALSE(rest.resting(a, b));
+    rest.begin();  // 22
+    rest.begin();  // 23: tried at 21, but no failure since 12: the row ended, nothing rests
+    rest.failed(a, b);
+    rest.begin();  // 24: one failure in a new row
     CHECK_FALSE(rest.resting(a, b));
     free_mesh(mesh);
     mesh = test::make_icosphere(2, 1.0);
