@@ -1060,20 +1060,19 @@ TEST_CASE("a patch relaxation that failed in two cleanups in a row rests for one
     CHECK_FALSE(rest.resting(a, b));
     // A row that goes on rests longer: after the third failure in a row (4, failed again at 7,
     // right after its rest of 2), 4 cleanups; after the fourth, 8, the longest.
+    auto rests_through = [&](int first, int last) {  // the cleanups first..last, a and b resting in each
+      for (int cleanup = first; cleanup <= last; ++cleanup) {
+        CAPTURE(cleanup);
+        rest.begin();
+        CHECK(rest.resting(a, b));
+      }
+    };
     rest.failed(a, b);
-    for (int cleanup = 8; cleanup <= 11; ++cleanup) {
-      CAPTURE(cleanup);
-      rest.begin();
-      CHECK(rest.resting(a, b));
-    }
+    rests_through(8, 11);
     rest.begin();  // 12
     CHECK_FALSE(rest.resting(a, b));
     rest.failed(a, b);
-    for (int cleanup = 13; cleanup <= 20; ++cleanup) {
-      CAPTURE(cleanup);
-      rest.begin();
-      CHECK(rest.resting(a, b));
-    }
+    rests_through(13, 20);
     rest.begin();  // 21
     CHECK_FALSE(rest.resting(a, b));
     rest.begin();  // 22
