@@ -91,7 +91,8 @@ Args parse_args(const std::vector<std::string>& args, const std::vector<OptionSp
         std::string next_name = next.substr(2);
         next_name.resize(std::min(next_name.size(), next_name.find('=')));
         if (next == "--" || std::any_of(spec.begin(), spec.end(), [&](const OptionSpec& s) { return s.name == next_name; }))
-          throw UsageError("option '--" + name + "' needs a value (" + it->value_name + "), but is followed by '" + next + "'");
+          throw UsageError("option '--" + name + "' needs a value (" + it->value_name + "), but is followed by '" + next +
+                           "' (a value that starts with -- goes as --" + name + "=VALUE)");
       }
       out.set(name, args[++i]);
     }

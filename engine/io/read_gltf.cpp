@@ -142,27 +142,23 @@ class Collector {
       fail("glTF: the scene visits its nodes more than " + std::to_string(max_visits) + " times (subtrees shared too often)");
     const tinygltf::Node& n = model_.nodes[static_cast<std::size_t>(index)];
     const Mat4 m = multiply(parent, local_transform(n));
-    // Said here, not as a vertex of the soup: a transform that overflows (scales of 1e200 on two
-    // levels) or holds a NaN makes every point of its meshes non-finite.
-    if (n.mesh >= 0 && !std::all_of(m.begin(), m.end(), [](double x) { return std::isfinite(x); }))
-      fail("glTF: node " + std::to_string(index) +
-           "'s transform (its matrix, translation, rotation or scale, times its parents') is not finite");
-    if (n.mesh >= 0) mesh(n.mesh, m);
+    if (n.mesh >= 0) mesh(n.mesh, m, index);
     for (int child : n.children) node(child, m, depth + 1);
   }
 
-  void mesh(int index, const Mat4& m) {
+  /// `node`: the node that places the mesh, for messages (-1: none, a scene without nodes).
+  void mesh(int index, const Mat4& m, int node) {
     if (static_cast<std::size_t>(index) >= model_.meshes.size())
       fail("glTF: reference to missing mesh " + std::to_string(index));
     const auto& prims = model_.meshes[static_cast<std::size_t>(index)].primitives;
     for (std::size_t p = 0; p < prims.size(); ++p)
-      primitive(prims[p], "mesh " + std::to_string(index) + " primitive " + std::to_string(p), m);
+      primitive(prims[p], "mesh " + std::to_string(index) + " primitive " + std::to_string(p), m, node);
   }
 
   RawSoup take() { return std::move(soup_); }
 
  private:
-  void primitive(const tinygltf::Primitive& prim, const std::string& what, const Mat4& m) {
+  void primitive(const tinygltf::Primitive& prim, const std::string& what, const Mat4& m, int node) {
     const int mode = prim.mode < 0 ? TINYGLTF_MODE_TRIANGLES : prim.mode;
     if (mode != TINYGLTF_MODE_TRIANGLES && mode != TINYGLTF_MODE_TRIANGLE_STRIP && mode != TINYGLTF_MODE_TRIANGLE_FAN)
       return;  // points and lines carry no surface
@@ -178,6 +174,12 @@ class Collector {
     // Instancing can multiply geometry: cap what one upload may expand to.
     if (first + pv.count > max_points_)
       fail("glTF: the scene expands to more than " + std::to_string(max_points_) + " vertices");
+    // Said here, not as a vertex of the soup: a transform that overflows (scales of 1e200 on two
+    // levels) or holds a NaN makes every point it places non-finite. (Only where it places some:
+    // a node whose mesh has only lines or points, or no positions, reads as before.)
+    if (pv.count > 0 && !std::all_of(m.begin(), m.end(), [](double x) { return std::isfinite(x); }))
+      fail("glTF: node " + std::to_string(node) +
+           "'s transform (its matrix, translation, rotation or scale, times its parents') is not finite");
     for (std::size_t i = 0; i < pv.count; ++i) {
       float c[3];
       std::memcpy(c, pv.base + i * pv.stride, 12);
@@ -352,7 +354,7 @@ RawSoup read_gltf(std::string_view bytes, bool binary, const ReadOptions& option
     for (std::size_t n = 0; n < model.nodes.size(); ++n)
       if (!is_child[n]) collect.node(static_cast<int>(n), identity(), 0);
     if (model.nodes.empty())
-      for (std::size_t m = 0; m < model.meshes.size(); ++m) collect.mesh(static_cast<int>(m), identity());
+      for (std::size_t m = 0; m < model.meshes.size(); ++m) collect.mesh(static_cast<int>(m), identity(), -1);
   }
   return collect.take();
 }

@@ -4,6 +4,7 @@
 /// ASCII records start on a new line; one with too few values on its line (a wrapped vertex, face
 /// or count line) takes the rest from the following lines, as the free-format spec allows.
 
+#include <algorithm>
 #include <exception>
 #include <string>
 
@@ -50,6 +51,14 @@ class Tokens {
     while (!next_token(rest_, tok))
       if (!next_content_line(lines_, rest_)) return false;
     return true;
+  }
+  /// True if the rest of the current line holds a printable character (not a line of NUL padding
+  /// or a DOS end-of-file mark).
+  bool line_has_text() const {
+    return std::any_of(rest_.begin(), rest_.end(), [](char c) {
+      const auto u = static_cast<unsigned char>(c);
+      return u > 0x20 && u != 0x7f;
+    });
   }
   /// True if the current line has tokens left.
   bool line_has_more() const {
@@ -165,10 +174,10 @@ RawSoup read_records(LineScanner lines, std::int64_t nv, std::int64_t nf) {
   }
   // Content after the declared faces is not read, but said: a face count too small in the header
   // drops the faces past it (the mesh then has holes there), which the reader used to do silently.
-  if (tokens.start()) {
-    const std::size_t first = tokens.line();
-    std::size_t extra = 1;
-    while (tokens.start()) ++extra;
+  std::size_t first = 0, extra = 0;
+  while (tokens.start())
+    if (tokens.line_has_text() && extra++ == 0) first = tokens.line();
+  if (extra > 0) {
     soup.repairs.push_back({"off_lines_after_faces_ignored", extra,
                             std::to_string(extra) + (extra == 1 ? " content line" : " content lines") + " after the " +
                                 std::to_string(nf) + " faces the header declares ignored, from line " +

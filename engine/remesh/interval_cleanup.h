@@ -79,7 +79,8 @@ class PatchRest {
   /// Starts the next cleanup (adds the property if the mesh has none; the first call replaces one
   /// the mesh came with).
   void begin();
-  /// Did a patch relaxation fail at both a and b in the cleanup before this one?
+  /// Are both a and b resting: each failed (a patch relaxation of one of its edges) within its
+  /// last rest_after(row) cleanups, not in this one?
   bool resting(OpenMesh::VertexHandle a, OpenMesh::VertexHandle b) const;
   /// A patch relaxation of the edge ab failed in this cleanup.
   void failed(OpenMesh::VertexHandle a, OpenMesh::VertexHandle b);

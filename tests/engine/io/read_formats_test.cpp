@@ -223,8 +223,10 @@ TEST_CASE("OFF: content after the declared faces is reported as ignored, a negat
   const std::size_t cube_lines = static_cast<std::size_t>(std::count(kCubeOff.begin(), kCubeOff.end(), '\n'));
   CHECK(ignored.detail == "2 content lines after the 6 faces the header declares ignored, from line " +
                               std::to_string(cube_lines + 2) + " (is the header's face count too small?)");
-  // Comments and blank lines alone after the faces are nothing to report.
+  // Comments and blank lines alone after the faces are nothing to report, nor NUL padding or a DOS
+  // end-of-file mark.
   CHECK(read_as(kCubeOff + "# end\n\n  \n").repairs.size() == plain.repairs.size());
+  CHECK(read_as(kCubeOff + std::string("\0\0\0\n\x1a", 5)).repairs.size() == plain.repairs.size());
 
   // Binary: a face whose vertex count is negative is named as such (it said the file ended first).
   std::string bin = test::write_off_binary(to_soup(test::make_icosphere(0)));
@@ -443,6 +445,16 @@ TEST_CASE("glTF: a node transform past the range of double is named, not reporte
         "transform is applied");
   // Large but finite: read.
   CHECK(read_error(scene(R"({"scale":[1e-100,1e-100,1e-100],"mesh":0})")).empty());
+  // The same overflowing transform over a mesh of lines only places no surface point: read, with
+  // the strip of another node (it was refused by the first form of the check).
+  const std::string lines_only = R"({"asset":{"version":"2.0"},"scene":0,"scenes":[{"nodes":[0,2]}],
+    "nodes":[{"scale":[1e200,1e200,1e200],"children":[1]},{"scale":[1e200,1e200,1e200],"mesh":1},{"mesh":0}],
+    "meshes":[{"primitives":[{"attributes":{"POSITION":0},"mode":5}]},{"primitives":[{"attributes":{"POSITION":0},"mode":1}]}],
+    "accessors":[{"bufferView":0,"componentType":5126,"count":4,"type":"VEC3"}],
+    "bufferViews":[{"buffer":0,"byteLength":48}],
+    "buffers":[{"byteLength":48,"uri":"data:application/octet-stream;base64,)" + unit_square_base64() + R"("}]})";
+  CHECK(read_error(lines_only).empty());
+  CHECK(read_as(lines_only).mesh.n_faces() == 2);
 }
 
 TEST_CASE("glTF: a buffer pointing to an external file is refused without reading it") {

@@ -1058,8 +1058,9 @@ TEST_CASE("a patch relaxation that failed in two cleanups in a row rests for one
     rest.begin();  // 6
     rest.begin();  // 7: nothing failed in 6
     CHECK_FALSE(rest.resting(a, b));
-    // A row that goes on rests longer: after the third failure in a row (4, failed again at 7,
-    // right after its rest of 2), 4 cleanups; after the fourth, 8, the longest.
+    // A row that goes on rests longer: failures at 1, 2, 4 and now 7 (right after the rest of 2
+    // the third gave) make a row of four, which rests 4 cleanups; the fifth, at 12, rests 8, the
+    // longest.
     auto rests_through = [&](int first, int last) {  // the cleanups first..last, a and b resting in each
       for (int cleanup = first; cleanup <= last; ++cleanup) {
         CAPTURE(cleanup);

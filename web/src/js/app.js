@@ -164,13 +164,19 @@ async function submit(e) {
     // Watching a job started elsewhere: run again on its (server-read) input, in its own format
     // where the server writes it (OBJ, OFF and PLY hold the coordinates exactly; GLB has float32,
     // as a glTF input had), so the new job keeps the input's name (it was renamed .glb).
+    const job = view.job;
     try {
-      const name = view.job.input?.filename || 'input';
-      const own = format_of(name);
-      const format = ['obj', 'off', 'ply', 'stl', 'glb'].includes(own) ? own : 'glb';
-      const res = await api.request(api.result_url(view.job.id, 'input', format));
-      const file_name = format === own ? name : `${name.replace(/\.[^.]*$/, '')}.glb`;
-      state.file = new File([await res.blob()], file_name);
+      // The format the server read it as (a mesh named .txt is OBJ), else the name's extension.
+      const name = job.input?.filename || 'input';
+      const own = [job.input?.format, format_of(name)].find((f) => ['obj', 'off', 'ply', 'stl', 'glb'].includes(f));
+      const format = own || 'glb';
+      const res = await api.request(api.result_url(job.id, 'input', format));
+      const blob = await res.blob();
+      // Another job opened meanwhile: this press was for the one no longer shown. A file chosen
+      // meanwhile is the one sent.
+      if (view.job !== job) return;
+      const stem = name.replace(/\.[^.]*$/, '');
+      if (!state.file) state.file = new File([blob], format_of(name) === format ? name : `${stem}.${format}`);
     } catch (err) {
       $('submit-status').textContent = `Cannot fetch the job's input: ${err.message}`;
       return;
@@ -225,6 +231,7 @@ async function submit(e) {
 /// brought into view when a job starts (at 390 px a tap on Remesh changed nothing on screen, and
 /// the job ran unseen 1 200 px further down).
 function show_job_panel() {
+  if (!matchMedia('(max-width: 860px)').matches) return;  // two columns: the panel is beside the form
   const panel = document.querySelector('section.job');
   const r = panel.getBoundingClientRect();
   if (r.top < 0 || r.top > 0.5 * innerHeight) panel.scrollIntoView({ block: 'start', behavior: 'smooth' });
@@ -267,7 +274,8 @@ const view = new JobView({
       show_repairs(job.input.repairs);
       // A job opened from the list is another input: its mean becomes the target (the interval
       // stays the job's own, written below).
-      params.set_input_mean(job.input.summary.edge_length?.mean, 'server', { target: first });
+      params.set_input_mean(job.input.summary.edge_length?.mean, 'server',
+        { target: first && job.id !== state.file_job });
     }
     if (job.input?.filename)
       $('file-name').textContent = `${job.input.filename}${job.input.bytes ? ` · ${bytes(job.input.bytes)}` : ''}`;

@@ -149,14 +149,14 @@ export class IterationChart {
         ctx.beginPath(); ctx.arc(x(rows[0].iteration), y(s.key(rows[0])), 2.5, 0, 7); ctx.fill();
       }
     }
-    // The reference lines' labels over the curves, on a patch of the panel's colour (drawn under
+    // The reference lines' labels over the curves, on a patch of the canvas' colour (drawn under
     // them, the mean's curve ran through "e_min").
     ctx.textAlign = 'left';
     ctx.textBaseline = 'bottom';
     for (const m of marks) {
       const yy = Math.round(y(m.value)) + 0.5;
       const tw = ctx.measureText(m.label).width;
-      ctx.fillStyle = css('--panel');
+      ctx.fillStyle = css('--bg');
       ctx.fillRect(pad.l + 1, yy - 13, tw + 4, 12);
       ctx.fillStyle = css(m.color);
       ctx.fillText(m.label, pad.l + 3, yy - 1);

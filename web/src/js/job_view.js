@@ -95,7 +95,10 @@ export class JobView {
     $('job-error').textContent = '';
     $('dual-summary').textContent = '';  // the last job's, until this one's document arrives
     try {
-      this.set_job(await api.get_job(id));
+      const job = await api.get_job(id);
+      // Stopped meanwhile (a file chosen, the job deleted, another watched): this document is stale.
+      if (generation !== this.generation) return;
+      this.set_job(job);
       const rows = await api.get_stats(id);
       if (generation !== this.generation) return;
       this.add_rows(rows);

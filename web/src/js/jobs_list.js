@@ -97,7 +97,10 @@ export class JobsList {
           try {
             await api.delete_job(job.id);
             this.on_deleted?.(job.id);
-          } catch (e) { alert(e.message); }
+          } catch (e) {
+            if (e.status === 404) this.on_deleted?.(job.id);  // gone already (expired, or deleted elsewhere)
+            else alert(e.message);
+          }
           this.refresh();
         });
         links.append(' ', del);
