@@ -151,15 +151,20 @@ export class IterationChart {
     }
     // The reference lines' labels over the curves, on a patch of the canvas' colour (drawn under
     // them, the mean's curve ran through "e_min").
+    // Each label sits above its line, or below it when the line above is too close (a narrow
+    // interval: the e_min label and its patch covered the e_max line and label).
     ctx.textAlign = 'left';
     ctx.textBaseline = 'bottom';
-    for (const m of marks) {
-      const yy = Math.round(y(m.value)) + 0.5;
+    const lines = marks.map((m) => ({ m, yy: Math.round(y(m.value)) + 0.5 })).sort((a, b) => a.yy - b.yy);
+    let above = -Infinity;  // the bottom of the last label drawn, higher up
+    for (const { m, yy } of lines) {
       const tw = ctx.measureText(m.label).width;
+      const top = yy - 13 >= above ? yy - 13 : yy + 1;
       ctx.fillStyle = css('--bg');
-      ctx.fillRect(pad.l + 1, yy - 13, tw + 4, 12);
+      ctx.fillRect(pad.l + 1, top, tw + 4, 12);
       ctx.fillStyle = css(m.color);
-      ctx.fillText(m.label, pad.l + 3, yy - 1);
+      ctx.fillText(m.label, pad.l + 3, top + 12);
+      above = top + 12;
     }
     // Legend, top right.
     ctx.textAlign = 'right';
