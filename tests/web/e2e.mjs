@@ -165,6 +165,11 @@ async function main() {
   await page.waitForFunction(() => /^seconds by step: stellar /.test(document.getElementById('progress-text').title), null, { timeout: 5000 }).catch(() => {});
   const steps_title = await page.getAttribute('#progress-text', 'title');
   check(/^seconds by step: stellar [\d.]+, flips [\d.]+, .*total [\d.]+$/.test(steps_title || ''), `time by step shown once succeeded (${steps_title})`);
+  // The keyboard goes from Remesh to the job's downloads, not through every recent job's links first.
+  await page.focus('#submit');
+  await page.keyboard.press('Tab');
+  const after_submit = await page.evaluate(() => document.activeElement?.closest('section')?.className || document.activeElement?.localName);
+  check(after_submit === 'job', `Tab from Remesh reaches the job panel (${after_submit})`);
   const dual_line = await page.textContent('#dual-summary');
   const job_doc = await (await fetch(`${base}/api/v1/jobs/${job_id}`)).json();
   check(job_doc.dual && dual_line.startsWith(`dual: ${job_doc.dual.atoms.toLocaleString('en-US')} atoms, ${job_doc.dual.bonds.toLocaleString('en-US')} bonds · rings `) &&
