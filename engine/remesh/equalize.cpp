@@ -372,8 +372,11 @@ void check_preconditions(const TriMesh& mesh, const Params& params) {
   check_vertex_stars(mesh);
   if (auto errors = check_against(mesh, params); !errors.empty()) throw ParamsError(std::move(errors));
   const std::size_t estimate = estimate_output_faces(mesh, params);
+  // The estimate stops at kMaxFaceEstimate: said as "over" that (it printed 1000000000000000000 as
+  // if counted).
   if (params.max_output_faces > 0 && estimate > params.max_output_faces)
-    throw LimitError("estimated output of " + std::to_string(estimate) + " faces exceeds the limit of " +
+    throw LimitError("estimated output of " + std::string(estimate >= kMaxFaceEstimate ? "over " : "") +
+                     std::to_string(estimate) + " faces exceeds the limit of " +
                      std::to_string(params.max_output_faces) + " faces (e_max too small for this mesh)");
 }
 
@@ -508,7 +511,7 @@ std::size_t estimate_output_faces(const TriMesh& mesh, const Params& params) {
   const double m = 0.5 * (run.e_min + run.e_max);
   if (!(m > 0) || !std::isfinite(m)) return 0;
   const double faces = surface_area(mesh) / (std::sqrt(3.0) / 4.0 * m * m);
-  if (!std::isfinite(faces) || faces > 1e18) return static_cast<std::size_t>(1e18);
+  if (!std::isfinite(faces) || faces > static_cast<double>(kMaxFaceEstimate)) return kMaxFaceEstimate;
   return static_cast<std::size_t>(std::ceil(faces));
 }
 

@@ -124,6 +124,8 @@ struct Result {
 /// Estimated face count of the output: area / (sqrt(3)/4 * m^2), m = (e_min + e_max) / 2, e_max at
 /// most the bounding-box diagonal (as equalize() takes it).
 std::size_t estimate_output_faces(const TriMesh& mesh, const Params& params);
+/// The largest estimate_output_faces() gives: past it (or not finite), it gives this.
+inline constexpr std::size_t kMaxFaceEstimate = 1'000'000'000'000'000'000;
 
 /// The spacing of the feature snap's points along the reference's creases (feature_snap.h): e_min,
 /// but never less than a quarter of m = (e_min + e_max) / 2. With [1.2, 1.8] it is e_min; an

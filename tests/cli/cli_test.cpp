@@ -658,6 +658,10 @@ TEST_CASE("a job over --max-faces is refused with exit 3", "[cli]") {
   CHECK(r.exit_code == 3);
   CHECK(lines(r.err) == 1);
   CHECK(!fs::exists(dir.file("out.obj")));
+  // Past the estimate's cap (e_max 1e-300: the count is no count) it says "over".
+  r = remesh_cli({dir.file("sphere.obj"), dir.file("out.obj"), "--emin", "1e-300", "--emax", "2e-300"});
+  CHECK(r.exit_code == 3);
+  CHECK(r.err.find("estimated output of over 1000000000000000000 faces") != std::string::npos);
 }
 
 TEST_CASE("output piped into a program that exits early does not stop the run", "[cli]") {
