@@ -55,6 +55,9 @@ bool wants_help(const std::vector<std::string>& args) {
 Args parse_args(const std::vector<std::string>& args, const std::vector<OptionSpec>& spec,
                 std::size_t min_positional, std::size_t max_positional) {
   Args out;
+  auto find_option = [&spec](const std::string& name) {
+    return std::find_if(spec.begin(), spec.end(), [&](const OptionSpec& s) { return s.name == name; });
+  };
   bool options_done = false;
   for (std::size_t i = 0; i < args.size(); ++i) {
     const std::string& a = args[i];
@@ -73,7 +76,7 @@ Args parse_args(const std::vector<std::string>& args, const std::vector<OptionSp
       inline_value = name.substr(eq + 1);
       name.resize(eq);
     }
-    auto it = std::find_if(spec.begin(), spec.end(), [&](const OptionSpec& s) { return s.name == name; });
+    auto it = find_option(name);
     if (it == spec.end()) throw UsageError("unknown option '--" + name + "'");
     if (out.has(name)) throw UsageError("option '--" + name + "' given twice");
     if (it->value_name.empty()) {
@@ -90,7 +93,7 @@ Args parse_args(const std::vector<std::string>& args, const std::vector<OptionSp
       if (next.rfind("--", 0) == 0) {
         std::string next_name = next.substr(2);
         next_name.resize(std::min(next_name.size(), next_name.find('=')));
-        if (next == "--" || std::any_of(spec.begin(), spec.end(), [&](const OptionSpec& s) { return s.name == next_name; }))
+        if (next == "--" || find_option(next_name) != spec.end())
           throw UsageError("option '--" + name + "' needs a value (" + it->value_name + "), but is followed by '" + next +
                            "' (a value that starts with -- goes as --" + name + "=VALUE)");
       }

@@ -78,22 +78,15 @@ function init_input() {
 /// A new input: preview it locally at once; the server's summary follows after the upload.
 async function choose_file(file) {
   state.file = file;
-  view.stop();
-  if (location.hash) history.replaceState(null, '', location.pathname + location.search);
-  reset_job_panel();
+  leave_job();
   $('file-name').textContent = `${file.name} · ${bytes(file.size)}`;
-  $('summary').replaceChildren();
-  $('repairs').replaceChildren();
   $('submit-status').textContent = '';
   clear_file_error();  // the last file's complaint is not about this one
-  for (const name of ['input', 'remeshed', 'dual']) state.viewer?.forget(name);
   set_available(['input']);
   $('show-input').checked = true;
   // The last input's target does not carry over ("Fill" gave an interval twice this file's mean);
   // the preview, if any, fills it and the interval from this file's mean.
   params.set_input_mean(NaN, '', { clear: true });
-  state.input_of = null;
-  state.watched = null;
   if (!['obj', 'off', 'ply', 'stl', 'gltf', 'glb'].includes(format_of(file.name))) {
     // The server also reads the content (a mesh named .txt works), so this is no verdict yet.
     status(`".${format_of(file.name)}" is not an extension the preview knows, so there is no preview; ` +
@@ -309,25 +302,31 @@ const jobs = new JobsList({ on_deleted: forget_job });
 /// that no download or view points at files that are gone ("no job with id ...").
 function forget_job(id) {
   if (view.job?.id !== id && state.watched !== id) return;
-  view.stop();
-  reset_job_panel();
+  leave_job();
   $('job-state').textContent = 'deleted';
-  state.watched = null;
-  state.input_of = null;
   state.job_state = null;
   if (state.file_job === id) state.file_job = null;
-  for (const name of ['input', 'remeshed', 'dual']) state.viewer?.forget(name);
   set_available([]);
-  $('summary').replaceChildren();
-  $('repairs').replaceChildren();
   if (!state.file) {
     $('file-name').textContent = '';
     params.set_input_mean(NaN, '', { clear: true });
   }
   status(state.file ? `The job was deleted with its files; Remesh uploads ${state.file.name} again.`
     : 'The job was deleted with its files. Drop a mesh to start.');
-  if (location.hash) history.replaceState(null, '', location.pathname + location.search);
   jobs.set_current('');
+}
+
+/// Stops watching the job shown (a new file chosen, or the job deleted): its stream, panel, address,
+/// input summary and meshes go.
+function leave_job() {
+  view.stop();
+  if (location.hash) history.replaceState(null, '', location.pathname + location.search);
+  reset_job_panel();
+  $('summary').replaceChildren();
+  $('repairs').replaceChildren();
+  for (const name of ['input', 'remeshed', 'dual']) state.viewer?.forget(name);
+  state.input_of = null;
+  state.watched = null;
 }
 
 function reset_job_panel() {
