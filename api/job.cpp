@@ -202,7 +202,8 @@ json job_to_json(const JobRecord& job, std::string_view prefix, double now) {
       {"outcome", job.outcome ? json(*job.outcome) : json(nullptr)},
       {"thin_parts", job.thin_parts ? thin_parts_to_json(*job.thin_parts) : json(nullptr)},
       {"crossing_pairs", job.crossing_pairs ? json(*job.crossing_pairs) : json(nullptr)},
-      {"layered", job.layered},
+      // Known once the run has succeeded, as crossing_pairs (null before: it read false, "no layers").
+      {"layered", job.state == JobState::Succeeded ? json(job.layered) : json(nullptr)},
       {"triangles", job.triangles ? json(*job.triangles) : json(nullptr)},
       {"seconds_by_step", job.seconds_by_step ? step_seconds_to_json(*job.seconds_by_step) : json(nullptr)},
       {"dual", job.dual ? dual_to_json(*job.dual) : json(nullptr)},

@@ -149,7 +149,9 @@ PreparedJob prepare_job(std::string_view bytes, std::string_view filename, std::
     throw ParamsError(std::move(mesh_errors));
   std::size_t estimate = estimate_output_faces(loaded.mesh, params.params);
   if (params.params.max_output_faces > 0 && estimate > params.params.max_output_faces)
-    throw LimitError("the result would have about " + std::to_string(estimate) + " faces, more than the limit of " +
+    // An estimate at its cap is a bound, not a count (1e-300 as emax said "about 1000000000000000000").
+    throw LimitError("the result would have " + std::string(estimate >= kMaxFaceEstimate ? "over " : "about ") +
+                     std::to_string(estimate) + " faces, more than the limit of " +
                      std::to_string(params.params.max_output_faces) + "; raise emin/emax");
 
   PreparedJob job{JobRecord{}, std::move(loaded)};

@@ -85,6 +85,9 @@ thread_local std::chrono::steady_clock::time_point t_request_start;
 /// line or header it cannot parse, a URI too long and a Range it cannot parse before routing: the
 /// error handler is then the first to see the request. Cleared when the request is logged.
 thread_local bool t_pre_routed = false;
+/// Bytes an event stream wrote on this thread for the current request (the access log's `bytes`:
+/// a chunked answer has no length of its own, and every stream was logged with bytes=0).
+thread_local std::size_t t_streamed_bytes = 0;
 
 double seconds_since(std::chrono::steady_clock::time_point t) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
@@ -125,6 +128,12 @@ void send_unsatisfiable(const httplib::Request& req, httplib::Response& res, std
 void send_ranged(const httplib::Request& req, httplib::Response& res, std::string bytes, const std::string& mime,
                  bool compress) {
   const std::size_t size = bytes.size();
+  // If-Range (RFC 9110 13.1.5): the range only if the answer is still the one the client has (the
+  // ETag it names, compared strongly); else the whole answer. It was ignored: a 206 of a changed file.
+  if (t_range && req.has_header("If-Range") &&
+      (!res.has_header("ETag") || req.get_header_value("If-Range") != res.get_header_value("ETag") ||
+       req.get_header_value("If-Range").starts_with("W/")))
+    t_range.reset();
   if (!t_range) {
     res.status = 200;
     if (compress) res.set_content(std::move(bytes), mime);
@@ -184,7 +193,7 @@ void close_after(const httplib::Request& req, httplib::Response& res) {
 
 /// The body's length as the access log gives it: a provided body (files, results, close_after) has
 /// no bytes in res.body, only its Content-Length (the log said 0 for every download); a chunked
-/// one (the event stream) has neither, and counts 0.
+/// one (the event stream) has neither, and counts 0 here (the logger adds t_streamed_bytes).
 std::size_t body_bytes(const httplib::Response& res) {
   return res.body.empty() && res.content_provider_ ? res.content_length_ : res.body.size();
 }
@@ -478,7 +487,8 @@ void HttpServer::Impl::setup() {
     metrics.observe_request(req.method, route, res.status, secs);
     log.info("request", {str("method", req.method), str("path", req.path), str("route", route),
                          num("status", res.status), num("ms", std::round(secs * 1e5) / 100),
-                         num("bytes", static_cast<double>(body_bytes(res))), str("remote", req.remote_addr)});
+                         num("bytes", static_cast<double>(body_bytes(res) + t_streamed_bytes)),
+                         str("remote", req.remote_addr)});
   });
 
   const std::string jobs_path = std::string(kPrefix) + "/jobs";
@@ -534,6 +544,7 @@ httplib::Server::HandlerResponse HttpServer::Impl::pre_route(const httplib::Requ
                                                              httplib::Response& res) {
   t_request_start = std::chrono::steady_clock::now();
   t_pre_routed = true;
+  t_streamed_bytes = 0;
   // The query as sent, before anything reads a parameter (the token included), and the byte range
   // taken for the handler to apply (t_range), so that httplib applies none. The request object is
   // httplib's own, not const; only its parsed parameters and ranges change.
@@ -563,14 +574,18 @@ httplib::Server::HandlerResponse HttpServer::Impl::pre_route(const httplib::Requ
     const bool plain_chunked = req.get_header_value_count("Transfer-Encoding") == 1 && codings.size() == 1 &&
                                codings.front() == "chunked" && only.size() == 7;
     if (!plain_chunked) {
-      // chunked alone, but spelt otherwise ("chunked,", or given on two lines): a 400 as well.
-      const bool chunked_last = codings.size() > 1 && codings.back() == "chunked";
+      // chunked alone, but spelt otherwise ("chunked,", or given on two lines): a 400 as well; so
+      // is chunked twice (RFC 9112 7: a body is chunked once), which was called a coding not
+      // implemented.
+      const bool all_chunked = std::all_of(codings.begin(), codings.end(), [](const auto& c) { return c == "chunked"; });
+      const bool chunked_last = codings.size() > 1 && codings.back() == "chunked" && !all_chunked;
       res.set_header("Connection", "close");
       send_problem(res, chunked_last ? 501 : 400,
                    "Transfer-Encoding '" + req.get_header_value("Transfer-Encoding").substr(0, 60) + "': " +
-                       (chunked_last                                         ? "no coding but chunked is implemented"
-                        : codings.size() == 1 && codings.front() == "chunked" ? "write it as the one value 'chunked'"
-                                       : "the body's length is unknown (chunked must be the last coding)"));
+                       (chunked_last ? "no coding but chunked is implemented"
+                        : all_chunked && codings.size() > 1 ? "chunked is given more than once (a body is chunked once)"
+                        : all_chunked ? "write it as the one value 'chunked'"
+                                      : "the body's length is unknown (chunked must be the last coding)"));
       return httplib::Server::HandlerResponse::Handled;
     }
   }
@@ -593,6 +608,30 @@ httplib::Server::HandlerResponse HttpServer::Impl::pre_route(const httplib::Requ
     if (length.empty() || length.find_first_not_of("0123456789") != std::string::npos) {
       res.set_header("Connection", "close");
       send_problem(res, 400, "malformed request: Content-Length '" + length.substr(0, 20) + "' is not a number");
+      return httplib::Server::HandlerResponse::Handled;
+    }
+  }
+  // A header that decides the answer, given twice: httplib took the first (Authorization right then
+  // wrong was let in, a proxy in front may take the last). Refused, naming it.
+  for (const char* name : {"Authorization", "Range", "If-Range", "If-None-Match", "Last-Event-ID", "Content-Type",
+                           "Content-Encoding"}) {
+    if (const std::size_t n = req.get_header_value_count(name); n > 1) {
+      if (has_body(req)) res.set_header("Connection", "close");  // its body is not read
+      send_problem(res, 400, std::string("malformed request: the header ") + name + " is given " + std::to_string(n) +
+                                 " times; give it once");
+      return httplib::Server::HandlerResponse::Handled;
+    }
+  }
+  // A body coding cpp-httplib 0.11 does not decode (zstd, compress, a list) it passed on as it came:
+  // the job was made of the coded bytes. It decodes gzip, deflate and br.
+  // It matches the name exactly: "GZIP" was passed on too.
+  if (req.has_header("Content-Encoding")) {
+    const std::string coding = req.get_header_value("Content-Encoding");
+    if (coding != "gzip" && coding != "deflate" && coding != "br" && coding != "identity") {
+      if (has_body(req)) res.set_header("Connection", "close");  // its body is not read
+      send_problem(res, 415, "Content-Encoding '" + coding.substr(0, 40) +
+                                 "' is not supported: send the body as it is, or coded with one of gzip, deflate, br "
+                                 "(in lower case)");
       return httplib::Server::HandlerResponse::Handled;
     }
   }
@@ -715,6 +754,8 @@ void HttpServer::Impl::post_job(const httplib::Request& req, httplib::Response& 
   std::string body, params_text, filename, part_type, part;
   bool too_big = false, params_too_big = false;
   int mesh_parts = 0, params_parts = 0;  // a second part of either is refused, not joined to the first
+  std::vector<std::string> other_parts;  // parts of other names, each once (refused, named)
+  constexpr std::size_t kMaxNamedParts = 16;
   auto count = [&](std::size_t n) {
     total += n;
     if (total > limit && !too_big) {
@@ -752,6 +793,9 @@ void HttpServer::Impl::post_job(const httplib::Request& req, httplib::Response& 
             part_type = header.content_type;
           } else if (part == "params") {
             ++params_parts;
+          } else if (std::find(other_parts.begin(), other_parts.end(), part) == other_parts.end() &&
+                     other_parts.size() < kMaxNamedParts) {
+            other_parts.push_back(part);
           }
           return true;
         },
@@ -786,6 +830,9 @@ void HttpServer::Impl::post_job(const httplib::Request& req, httplib::Response& 
     if (req.is_multipart_form_data() && b != std::string::npos && type.find(';', b) != std::string::npos)
       send_problem(res, 400, "multipart/form-data: nothing may follow the boundary parameter (drop '" +
                                  type.substr(type.find(';', b)).substr(0, 40) + "')");
+    else if (req.has_header("Content-Encoding"))
+      send_problem(res, 400, "the request body could not be decoded as Content-Encoding '" +
+                                 req.get_header_value("Content-Encoding").substr(0, 40) + "' (or it was cut off)");
     else
       send_problem(res, 400, "the request body could not be read (malformed or interrupted upload)");
     return;
@@ -816,6 +863,16 @@ void HttpServer::Impl::post_job(const httplib::Request& req, httplib::Response& 
     }
   } else {
     parsed = remesh::params_from_query(query_params(req), kUploadQueryKeys);
+  }
+  // A part of another name was dropped without a word (a typo 'param' lost its settings; `-F emin=1`
+  // was answered "emin is required").
+  for (const std::string& name : other_parts) {
+    const auto& names = remesh::param_names();
+    const bool param = std::find(names.begin(), names.end(), name) != names.end();
+    errors.push_back({name.substr(0, 64), param ? "is a part of its own: job parameters go in the JSON part 'params' "
+                                                  "(or all in the query)"
+                                                : "unknown part: a job takes a file part 'mesh' and a JSON part "
+                                                  "'params'"});
   }
   if (req.is_multipart_form_data() && mesh_parts == 0) errors.push_back({"mesh", "is required (a file field named 'mesh')"});
   else if (body.empty()) errors.push_back({"mesh", "is empty"});
@@ -988,6 +1045,7 @@ void HttpServer::Impl::events(const httplib::Request& req, httplib::Response& re
           out = sse_comment("ping");
         }
         if (!sink.write(out.data(), out.size())) return false;
+        t_streamed_bytes += out.size();
         if (finish) sink.done();
         return true;
       },
@@ -1029,13 +1087,26 @@ void HttpServer::Impl::result(const httplib::Request& req, httplib::Response& re
     send_problem(res, 422, std::string("this mesh cannot be written as ") + format + ": " + e.what());
     return;
   } catch (const std::exception& e) {
-    send_problem(res, 500, std::string("cannot produce the file: ") + e.what());
+    // Deleted meanwhile (its directory went while the file was made): a 404, as a moment later.
+    if (!jobs.record(rec->id)) {
+      send_problem(res, 404, "the job was removed while its file was being made");
+      return;
+    }
+    // The reason (it names paths on the server) goes to the log only.
+    log.error("handler", {str("path", req.path), str("job", rec->id), str("error", e.what())});
+    send_problem(res, 500, "cannot make the " + format + " file of this job (the service's log says why)");
     return;
   }
   std::error_code ec;
   auto size = std::filesystem::file_size(path, ec);
-  if (ec) {
-    send_problem(res, 404, "the file is gone (the job was removed)");
+  if (ec || !std::filesystem::is_regular_file(path, ec)) {
+    if (!jobs.record(rec->id)) {
+      send_problem(res, 404, "the file is gone (the job was removed)");
+      return;
+    }
+    log.error("handler", {str("path", req.path), str("job", rec->id), str("error", "missing " + path.string())});
+    send_problem(res, 500, "the job's " + mesh + "." + format +
+                               " file is missing from the service's data directory (removed or damaged there)");
     return;
   }
   std::string etag = "\"" + rec->id + "-" + mesh + "-" + format + "-" + std::to_string(size) + "\"";

@@ -314,6 +314,19 @@ void JobManager::run(const std::string& id) {
       finish(JobState::Cancelled);
       return;
     }
+    bool cancelled_late = false;
+    {
+      // Cancelled after the run's last check for a stop (while its results were written): the
+      // DELETE was answered `cancelling`, so the job ends cancelled, as one stopped sooner does
+      // (its files are not served: results are served only for a job that succeeded).
+      std::lock_guard lock(mutex_);
+      cancelled_late = job->record.state == JobState::Cancelling;
+      if (cancelled_late) job->record.outcome = "cancelled";
+    }
+    if (cancelled_late) {
+      finish(JobState::Cancelled);
+      return;
+    }
     {
       std::lock_guard lock(mutex_);
       job->record.outcome = std::string(remesh::api::outcome_name(result.outcome));
@@ -456,6 +469,9 @@ std::filesystem::path JobManager::file(const std::string& id, const std::string&
   std::string bytes = input ? convert_input(*rec, store_.read_upload(id), name.substr(6))
                             : convert_result(read_file(obj), name.substr(dot + 1));
   store_.write_file(id, name, bytes);
+  // The data cap counts it now (the janitor wakes), not when the next job finishes: downloads of
+  // input conversions alone grew a capped directory past its cap.
+  if (config_.data_cap_bytes > 0) janitor_wake_.notify_all();
   return path;
 }
 

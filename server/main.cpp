@@ -1,5 +1,5 @@
 // remeshd: the remeshing service. Parses options, opens the data directory, starts the workers and
-// the HTTP server, and shuts down cleanly on SIGTERM/SIGINT (running jobs stay re-queueable).
+// the HTTP server, and shuts down cleanly on SIGTERM/SIGINT/SIGHUP (running jobs stay re-queueable).
 #include <pthread.h>
 #include <signal.h>
 #ifdef __GLIBC__
@@ -47,8 +47,14 @@ int main(int argc, char** argv) {
   sigemptyset(&signals);
   sigaddset(&signals, SIGINT);
   sigaddset(&signals, SIGTERM);
+  // A hangup (the terminal closed, or a supervisor's reload) stops the service as SIGTERM does; it
+  // killed it, and two during one job failed that job as if it had crashed it (JobRecord::attempts).
+  // The user signals, which it has no use for, are ignored.
+  sigaddset(&signals, SIGHUP);
   pthread_sigmask(SIG_BLOCK, &signals, nullptr);
   ::signal(SIGPIPE, SIG_IGN);
+  ::signal(SIGUSR1, SIG_IGN);
+  ::signal(SIGUSR2, SIG_IGN);
 
   try {
     unsigned cores = std::max(1u, std::thread::hardware_concurrency());
@@ -67,7 +73,9 @@ int main(int argc, char** argv) {
     HttpServer http(o, jobs, metrics, log, web_root);
     int port = http.bind();
     jobs.start();
-    log.info("listening", {str("url", "http://" + o.host + ":" + std::to_string(port) + "/"), num("port", port),
+    // An IPv6 address goes in brackets in a URL (http://[::1]:8080/).
+    const std::string host = o.host.find(':') != std::string::npos ? "[" + o.host + "]" : o.host;
+    log.info("listening", {str("url", "http://" + host + ":" + std::to_string(port) + "/"), num("port", port),
                            num("workers", mc.workers), str("data_dir", o.data_dir), str("web_root", web_root.string()),
                            str("auth", o.token.empty() ? "off" : "bearer token"),
                            str("cors", o.cors_origin.empty() ? "off" : o.cors_origin)});
@@ -77,7 +85,10 @@ int main(int argc, char** argv) {
     std::thread signal_thread([&] {
       int sig = 0;
       sigwait(&signals, &sig);
-      log.info("shutdown", {str("signal", sig == SIGTERM ? "SIGTERM" : sig == SIGINT ? "SIGINT" : "internal")});
+      log.info("shutdown", {str("signal", sig == SIGTERM  ? "SIGTERM"
+                                          : sig == SIGINT ? "SIGINT"
+                                          : sig == SIGHUP ? "SIGHUP"
+                                                          : "internal")});
       jobs.shutdown();  // interrupts running jobs; they stay 'running' on disk and run again on start
       // serve() returns when cpp-httplib 0.11's thread pool has joined every connection's thread,
       // and a connection ends when its client is done: one that sends a byte now and then (each

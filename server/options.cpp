@@ -3,6 +3,7 @@
 #include <cctype>
 #include <charconv>
 #include <cmath>
+#include <cstdint>
 #include <cstdlib>
 #include <functional>
 #include <stdexcept>
@@ -24,11 +25,16 @@ struct Spec {
   std::function<void(Options&, const std::string&)> set;
 };
 
-std::size_t to_size(const std::string& name, const std::string& v) {
+/// The most worker or HTTP threads (`--workers 100000` failed after 3 s with "Resource temporarily
+/// unavailable", not naming the option).
+constexpr std::size_t kMaxThreads = 4096;
+
+std::size_t to_size(const std::string& name, const std::string& v, std::size_t max = SIZE_MAX) {
   std::size_t out = 0;
   auto [p, ec] = std::from_chars(v.data(), v.data() + v.size(), out);
   if (ec != std::errc() || p != v.data() + v.size() || v.empty())
     throw std::invalid_argument("--" + name + ": '" + v + "' is not a non-negative integer");
+  if (out > max) throw std::invalid_argument("--" + name + ": " + v + " is more than " + std::to_string(max));
   return out;
 }
 
@@ -51,7 +57,7 @@ const std::vector<Spec>& specs() {
          o.port = static_cast<int>(p);
        }},
       {"workers", "N", "remesh worker threads (default: number of cores)",
-       [](Options& o, const std::string& v) { o.workers = static_cast<unsigned>(to_size("workers", v)); }},
+       [](Options& o, const std::string& v) { o.workers = static_cast<unsigned>(to_size("workers", v, kMaxThreads)); }},
       {"data-dir", "DIR",
        "job storage (default $XDG_STATE_HOME/remeshd, else ~/.local/state/remeshd, else ./remeshd-data)",
        [](Options& o, const std::string& v) { o.data_dir = v; }},
@@ -93,7 +99,12 @@ const std::vector<Spec>& specs() {
            throw std::invalid_argument("--data-cap-mb: " + v + " is past 2^40 MiB (0 = no cap)");
        }},
       {"token", "T", "require 'Authorization: Bearer T' on every /api route (default: none)",
-       [](Options& o, const std::string& v) { o.token = v; }},
+       [](Options& o, const std::string& v) {
+         // An empty one (REMESHD_TOKEN=${UNSET} in a compose file) served every route without one.
+         if (v.empty())
+           throw std::invalid_argument("--token (or REMESHD_TOKEN) is empty; leave it out to serve without a token");
+         o.token = v;
+       }},
       {"cors-origin", "O", "allow cross-origin requests from O ('*' = any; default: CORS off)",
        [](Options& o, const std::string& v) { o.cors_origin = v; }},
       {"log-format", "text|json", "log line format (default text)",
@@ -104,9 +115,15 @@ const std::vector<Spec>& specs() {
       {"web-root", "DIR", "directory of the web page (default: the build's web/ or <exe>/../web)",
        [](Options& o, const std::string& v) { o.web_root = v; }},
       {"http-threads", "N", "HTTP thread pool size (default: max-streams + 16)",
-       [](Options& o, const std::string& v) { o.http_threads = static_cast<unsigned>(to_size("http-threads", v)); }},
+       [](Options& o, const std::string& v) {
+         o.http_threads = static_cast<unsigned>(to_size("http-threads", v, kMaxThreads));
+       }},
       {"max-streams", "N", "concurrent event streams before 503 (default 64)",
-       [](Options& o, const std::string& v) { o.max_streams = static_cast<unsigned>(to_size("max-streams", v)); }},
+       [](Options& o, const std::string& v) {
+         o.max_streams = static_cast<unsigned>(to_size("max-streams", v, kMaxThreads));
+         // 0 answered every event stream with 503.
+         if (o.max_streams == 0) throw std::invalid_argument("--max-streams: at least 1");
+       }},
       {"stream-lifetime-seconds", "S", "an event stream ends after S seconds; clients reconnect (default 300)",
        [](Options& o, const std::string& v) {
          o.stream_lifetime_seconds = to_double("stream-lifetime-seconds", v);

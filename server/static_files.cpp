@@ -46,6 +46,7 @@ std::optional<fs::path> static_file(const fs::path& root, std::string_view url_p
   if (ec) return std::nullopt;
   fs::path candidate = canonical_root / rel;
   if (fs::is_directory(candidate, ec)) candidate /= "index.html";
+  else if (url_path.back() == '/') return std::nullopt;  // a file named as a directory (/style.css/)
   fs::path real = fs::canonical(candidate, ec);
   if (ec || !fs::is_regular_file(real, ec)) return std::nullopt;
   // Symlinks must not lead out of the root.

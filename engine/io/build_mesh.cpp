@@ -42,9 +42,10 @@ void validate(const RawSoup& raw) {
            " vertices; a face needs at least 3");
     for (std::uint32_t k = b; k < e; ++k)
       if (raw.indices[k] < 0 || raw.indices[k] >= nv)
-        fail("face " + std::to_string(f) + raw.face_where(f) + " refers to vertex " + std::to_string(raw.indices[k]) +
-             ", but there " + (nv == 1 ? "is 1 vertex" : "are " + std::to_string(nv) + " vertices") +
-             " (0-based indices)");
+        fail("face " + std::to_string(f) + raw.face_where(f) + " refers to vertex " +
+             std::to_string(raw.indices[k] + raw.index_base) + ", but there " +
+             (nv == 1 ? "is 1 vertex" : "are " + std::to_string(nv) + " vertices") +
+             (raw.index_base == 1 ? " (OBJ counts from 1)" : " (0-based indices)"));
   }
 }
 

@@ -14,8 +14,8 @@
 ///     follow"); records an OFF or PLY file ends before ("OFF: file ends after 3 of 4 faces"; the
 ///     last line of a text file needs no line break); non-finite coordinates ("vertex 7 (line 9)
 ///     has a non-finite coordinate (nan, 0, 1)"); faces with < 3 vertices ("face 4 (line 9) has 2
-///     vertices; a face needs at least 3"); indices out of range ("face 1 (line 6) refers to vertex
-///     8, but there are 4 vertices (0-based indices)"); edges with more than two faces
+///     vertices; a face needs at least 3"); indices out of range, as the file counts them ("face 1 (line 6) refers to
+///     vertex 9, but there are 4 vertices (OBJ counts from 1)"); edges with more than two faces
 ///     ("non-manifold mesh: N edges are shared by more than 2 faces; the first joins vertices A and
 ///     B (shared by k faces, e.g. face F (line L))"); non-orientable components ("non-orientable
 ///     surface (e.g. a Moebius strip): ..."); no face left ("all N faces are degenerate or

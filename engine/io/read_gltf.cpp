@@ -155,13 +155,22 @@ class Collector {
       primitive(prims[p], "mesh " + std::to_string(index) + " primitive " + std::to_string(p), m, node);
   }
 
-  RawSoup take() { return std::move(soup_); }
+  /// The soup; a scene whose primitives are all points or lines is refused saying so (it read as
+  /// "no vertices and no faces").
+  RawSoup take() {
+    if (soup_.face_count() == 0 && skipped_mode_ >= 0)
+      fail("glTF: its primitives are " + std::string(skipped_mode_ == TINYGLTF_MODE_POINTS ? "points" : "lines") +
+           " (mode " + std::to_string(skipped_mode_) + "), no triangles: there is no surface to remesh");
+    return std::move(soup_);
+  }
 
  private:
   void primitive(const tinygltf::Primitive& prim, const std::string& what, const Mat4& m, int node) {
     const int mode = prim.mode < 0 ? TINYGLTF_MODE_TRIANGLES : prim.mode;
-    if (mode != TINYGLTF_MODE_TRIANGLES && mode != TINYGLTF_MODE_TRIANGLE_STRIP && mode != TINYGLTF_MODE_TRIANGLE_FAN)
+    if (mode != TINYGLTF_MODE_TRIANGLES && mode != TINYGLTF_MODE_TRIANGLE_STRIP && mode != TINYGLTF_MODE_TRIANGLE_FAN) {
+      if (skipped_mode_ < 0) skipped_mode_ = mode;
       return;  // points and lines carry no surface
+    }
     if (prim.extensions.count("KHR_draco_mesh_compression"))
       fail("glTF: " + what + " is Draco-compressed (not supported)");
     auto pos = prim.attributes.find("POSITION");
@@ -261,6 +270,7 @@ class Collector {
   std::size_t visits_ = 0;
   std::size_t max_points_;
   std::size_t max_triangles_;  ///< what the scene may expand to (instancing)
+  int skipped_mode_ = -1;      ///< the mode of the first primitive of points or lines passed over
 };
 
 /// How deep arrays and objects nest in a JSON text (strings skipped), stopping once past `limit`.
@@ -298,8 +308,11 @@ std::string_view json_text(std::string_view bytes, bool binary) {
   return bytes.substr(20, std::min<std::size_t>(length, bytes.size() - 20));
 }
 
+/// The first line of tinygltf's error, without the JSON library's tag ("[json.exception.parse_error.101] ").
 std::string first_line(const std::string& s) {
   std::string t = s.substr(0, s.find('\n'));
+  if (const std::size_t tag = t.find("[json.exception."); tag != std::string::npos)
+    if (const std::size_t end = t.find("] ", tag); end != std::string::npos) t.erase(tag, end + 2 - tag);
   return t.empty() ? "unknown error" : t;
 }
 
@@ -312,6 +325,16 @@ RawSoup read_gltf(std::string_view bytes, bool binary, const ReadOptions& option
     ByteReader r(bytes, 4);
     const std::uint32_t version = r.read<std::uint32_t>(false);
     if (version != 2) fail("GLB: version " + std::to_string(version) + " (only glTF 2.0 is supported)");
+    // A file cut short: tinygltf said only "Invalid glTF binary."
+    const std::uint32_t declared = r.read<std::uint32_t>(false);
+    if (declared > bytes.size())
+      fail("GLB: the file is " + std::to_string(bytes.size()) + " bytes, but its header says " +
+           std::to_string(declared) + " (cut short?)");
+    ByteReader chunk(bytes, 12);
+    const std::uint32_t json_length = chunk.read<std::uint32_t>(false);
+    if (20 + static_cast<std::uint64_t>(json_length) > bytes.size())
+      fail("GLB: its JSON chunk of " + std::to_string(json_length) + " bytes reaches past the end of the file (" +
+           std::to_string(bytes.size()) + " bytes; cut short?)");
   }
   if (json_depth(json_text(bytes, binary), kMaxJsonDepth) > kMaxJsonDepth)
     fail(std::string(binary ? "GLB" : "glTF") + ": its JSON nests arrays and objects more than " +
@@ -334,6 +357,10 @@ RawSoup read_gltf(std::string_view bytes, bool binary, const ReadOptions& option
     fail(std::string(binary ? "GLB" : "glTF") + ": malformed structure the glTF loader could not read (" +
          e.what() + ")");
   }
+  // tinygltf asks for a data: URI it cannot decode as a file.
+  if (guard.first_external.starts_with("data:"))
+    fail("glTF: a data: URI that is not base64 data (" + quote(guard.first_external.substr(0, 40)) +
+         "); only ';base64,' data URIs (or .glb) are read");
   if (!guard.first_external.empty())
     fail("glTF refers to an external file " + quote(guard.first_external) +
          "; only embedded data (data: URIs or .glb) is accepted");

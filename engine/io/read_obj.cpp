@@ -54,6 +54,7 @@ void parse_face(std::string_view rest, std::size_t line, RawSoup& soup) {
 
 RawSoup read_obj(std::string_view bytes, const ReadOptions& options) {
   RawSoup soup;
+  soup.index_base = 1;
   LineScanner lines(bytes);
   std::string_view line;
   while (lines.next(line)) {

@@ -19,6 +19,8 @@ struct RawSoup {
   std::vector<std::uint32_t> offsets{0};   ///< face f = indices[offsets[f] .. offsets[f+1])
   std::vector<std::uint32_t> face_lines;   ///< source line of each face (text formats), else empty
   std::vector<Repair> repairs;             ///< repairs a reader made itself (rare)
+  /// How the file counts its vertices (1 for OBJ): an index out of range is named as written.
+  int index_base = 0;
 
   std::size_t face_count() const { return offsets.size() - 1; }
   /// " (line N)" for point i if known, else "".

@@ -76,6 +76,31 @@ TEST_CASE("remeshd: cancel queued and running jobs, the queue bound", "[server][
   CHECK(c.Delete(("/api/v1/jobs/" + running).c_str())->status == 204);
 }
 
+TEST_CASE("remeshd: a cancel after the run's last iteration, while its results are written, cancels the job",
+          "[server][cancel]") {
+  // After its last row the run makes and writes its results (81 920 faces: the remeshed mesh and
+  // its dual in every format), with no more checks for a stop. A DELETE then was answered
+  // `cancelling` and the job ended `succeeded` (a service QA finding).
+  TempDir tmp;
+  Daemon d(tmp.path / "data", {"--workers", "1"});
+  auto c = d.client();
+  const std::string id = submit(c, sphere_obj(6), "emin=0.016&emax=0.024&iterations=1&run_all_iterations=true");
+  const json last = wait_job(c, id, [](const json& j) {
+    return j["state"] != "queued" && (j["state"] != "running" || j["progress"]["iteration"] >= 1);
+  });
+  REQUIRE(last["state"] == "running");  // caught after its row, before its results were written
+  auto r = c.Delete(("/api/v1/jobs/" + id).c_str());
+  REQUIRE(r);
+  CHECK(r->status == 202);
+  CHECK(json::parse(r->body)["state"] == "cancelling");
+  const json after = wait_final(c, id, 60);
+  CHECK(after["state"] == "cancelled");
+  CHECK(after["outcome"] == "cancelled");
+  auto download = c.Get(("/api/v1/jobs/" + id + "/result?mesh=remeshed&format=obj").c_str());
+  REQUIRE(download);
+  CHECK(download->status == 409);
+}
+
 TEST_CASE("remeshd: bearer token on /api routes only, CORS", "[server][auth]") {
   TempDir tmp;
   TempDir web;
@@ -364,6 +389,33 @@ TEST_CASE("remeshd: SIGTERM interrupts running jobs without losing them, expiry"
     CHECK(gone);
     CHECK_FALSE(std::filesystem::exists(data / "jobs" / id));
   }
+}
+
+TEST_CASE("remeshd: SIGHUP stops the service as SIGTERM does, SIGUSR1 and SIGUSR2 are ignored", "[server][restart]") {
+  // Each killed the daemon (exit 129, 138): a run it stopped so counted as a crash, and two such
+  // signals during one job failed the job (a service QA finding).
+  TempDir tmp;
+  const auto data = tmp.path / "data";
+  std::string id;
+  {
+    Daemon d(data, {"--workers", "1"});
+    auto c = d.client();
+    id = submit(c, sphere_obj(4), "emin=0.05&emax=0.08&iterations=10&run_all_iterations=true");
+    wait_job(c, id, running_with_rows);
+    REQUIRE(::kill(d.pid(), SIGUSR1) == 0);
+    REQUIRE(::kill(d.pid(), SIGUSR2) == 0);
+    std::this_thread::sleep_for(std::chrono::milliseconds(300));
+    auto alive = c.Get("/healthz");
+    REQUIRE(alive);
+    CHECK(alive->status == 200);
+    CHECK(d.stop(SIGHUP) == 0);
+    CHECK(d.log().find("SIGHUP") != std::string::npos);
+  }
+  Daemon again(data, {"--workers", "1"});
+  auto c = again.client();
+  const json done = wait_final(c, id, 90);
+  CHECK(done["state"] == "succeeded");
+  CHECK(done["attempts"] == 1);  // the run the hangup stopped does not count
 }
 
 TEST_CASE("remeshd: SIGTERM waits a short grace for slow clients and not for them to finish", "[server][restart]") {

@@ -1029,3 +1029,90 @@ TEST_CASE("remeshd: byte ranges end at the answer's end, a 416 gives the length,
     CHECK(stream.events.back().event == "end");
   }
 }
+
+TEST_CASE("remeshd: answers a service QA pass found wrong or unclear", "[server]") {
+  TempDir tmp;
+  const auto data = tmp.path / "data";
+  Daemon d(data, {"--workers", "1"});
+  auto c = d.client();
+  const std::string mesh = sphere_obj(1);
+
+  // A multipart part of another name was dropped without a word: `-F emin=...` was answered "emin
+  // is required", a typo 'param' lost its settings and the job ran with the defaults.
+  httplib::MultipartFormDataItems stray = {{"mesh", mesh, "a.obj", ""},
+                                           {"emin", "0.3", "", ""},
+                                           {"param", R"({"iterations":5})", "", ""}};
+  auto sp = c.Post("/api/v1/jobs?emax=0.5", stray);
+  REQUIRE(sp);
+  CHECK(sp->status == 422);
+  const std::set<std::string> fields = error_fields(sp);
+  CHECK(fields.count("emin") == 1);
+  CHECK(fields.count("param") == 1);
+  CHECK(body_of(sp).dump().find("is a part of its own") != std::string::npos);
+
+  // A body coding cpp-httplib does not decode went through as it came (the job made of its bytes).
+  for (const char* coding : {"zstd", "GZIP", "gzip, br"}) {
+    CAPTURE(coding);
+    auto r = c.Post("/api/v1/jobs?emin=0.3&emax=0.5", {{"Content-Encoding", coding}}, mesh, "model/obj");
+    REQUIRE(r);
+    CHECK(r->status == 415);
+    CHECK(body_of(r)["detail"].get<std::string>().find(coding) != std::string::npos);
+  }
+  // A header that decides the answer, given twice: the first one won (a right token then a wrong one
+  // was let in).
+  auto twice = c.Get("/api/v1/jobs", {{"Range", "bytes=0-1"}, {"Range", "bytes=2-3"}});
+  REQUIRE(twice);
+  CHECK(twice->status == 400);
+  CHECK(body_of(twice)["detail"].get<std::string>().find("Range is given 2 times") != std::string::npos);
+  // chunked twice was "no coding but chunked is implemented" (501).
+  const std::string chunked_twice =
+      raw_exchange(d.port(),
+                   "POST /api/v1/jobs?emin=0.3&emax=0.5 HTTP/1.1\r\nHost: x\r\nTransfer-Encoding: chunked\r\n"
+                   "Transfer-Encoding: chunked\r\nConnection: close\r\n\r\n0\r\n\r\n",
+                   10);
+  CHECK(chunked_twice.rfind("HTTP/1.1 400", 0) == 0);
+  CHECK(chunked_twice.find("chunked is given more than once") != std::string::npos);
+
+  // A job's layered is null until it has succeeded (it read false: "not layered").
+  auto r = submit_raw(c, mesh, "emin=0.3&emax=0.5&iterations=3");
+  REQUIRE(r);
+  REQUIRE(r->status == 202);
+  const std::string id = body_of(r)["id"];
+  CHECK((body_of(r)["layered"].is_null()));
+  REQUIRE(wait_final(c, id)["state"] == "succeeded");
+  CHECK(get_job(c, id)["layered"] == false);
+
+  // If-Range naming another version: the whole file (RFC 9110 13.1.5), not the range.
+  const std::string result = "/api/v1/jobs/" + id + "/result?mesh=remeshed&format=obj";
+  auto whole = c.Get(result.c_str());
+  REQUIRE(whole);
+  REQUIRE(whole->status == 200);
+  const std::string etag = whole->get_header_value("ETag");
+  auto stale = c.Get(result.c_str(), {{"Range", "bytes=0-5"}, {"If-Range", "\"another\""}});
+  REQUIRE(stale);
+  CHECK(stale->status == 200);
+  CHECK(stale->body == whole->body);
+  auto current = c.Get(result.c_str(), {{"Range", "bytes=0-5"}, {"If-Range", etag}});
+  REQUIRE(current);
+  CHECK(current->status == 206);
+  CHECK(current->body == whole->body.substr(0, 6));
+
+  // A result file gone from the data directory while its job stays was "the job was removed" (404).
+  std::filesystem::remove(data / "jobs" / id / "remeshed.obj");
+  auto missing = c.Get(result.c_str());
+  REQUIRE(missing);
+  CHECK(missing->status == 500);
+  CHECK(body_of(missing)["detail"].get<std::string>().find("missing from the service's data directory") !=
+        std::string::npos);
+  // A file made on demand from files gone: 500 naming no path on the server (it gave the path).
+  std::filesystem::remove(data / "jobs" / id / "upload");
+  auto no_upload = c.Get(("/api/v1/jobs/" + id + "/result?mesh=input&format=ply").c_str());
+  REQUIRE(no_upload);
+  CHECK(no_upload->status == 500);
+  CHECK(no_upload->body.find(tmp.path.string()) == std::string::npos);
+  CHECK(no_upload->body.find("/jobs/") == std::string::npos);
+
+  // A static file named as a directory was served (/app.js/).
+  CHECK(c.Get("/index.html")->status == 200);
+  CHECK(c.Get("/index.html/")->status == 404);
+}

@@ -82,12 +82,26 @@ TEST_CASE("options: defaults, command line, environment, errors", "[server][opti
                                                          {"--max-upload-mb", "0"},
                                                          // a queue that takes no job (every POST was a 503)
                                                          {"--queue-size", "0"},
-                                                         {"--data-cap-mb", "17592186044416"}}) {
+                                                         {"--data-cap-mb", "17592186044416"},
+                                                         // an empty token served without one
+                                                         {"--token", ""},
+                                                         {"--token="},
+                                                         // streams all refused; threads past the system's
+                                                         {"--max-streams", "0"},
+                                                         {"--workers", "100000"},
+                                                         {"--http-threads", "100000"}}) {
+    CAPTURE(bad);
     auto r = Args(bad).parse();
     CHECK_FALSE(r.options);
     CHECK(r.exit_code == 2);
     CHECK(r.message.find('\n') == std::string::npos);
+    CHECK(r.message.find(bad[0].substr(0, bad[0].find('='))) != std::string::npos);  // names the option
   }
+  setenv("REMESHD_TOKEN", "", 1);
+  auto empty_env = Args({}).parse();
+  unsetenv("REMESHD_TOKEN");
+  CHECK_FALSE(empty_env.options);
+  CHECK(empty_env.message.find("REMESHD_TOKEN") != std::string::npos);
   auto h = Args({"--help"}).parse();
   CHECK_FALSE(h.options);
   CHECK(h.exit_code == 0);
@@ -107,7 +121,7 @@ TEST_CASE("static_file never leaves the web root", "[server][static]") {
   CHECK(static_file(web, "/sub/a.js") == fs::canonical(web / "sub" / "a.js"));
   CHECK(static_file(web, "/sub//a.js").has_value());
   for (const char* bad : {"/../secret", "/sub/../../secret", "/link", "/.hidden", "/sub/..", "relative",
-                          "/nothing.js", "/sub/a.js\\..", ""})
+                          "/nothing.js", "/sub/a.js\\..", "", "/sub/a.js/", "/index.html/"})
     CHECK_FALSE(static_file(web, bad));
   CHECK(mime_for("a.mjs").rfind("text/javascript", 0) == 0);
   CHECK(mime_for("a.WASM") == "application/wasm");

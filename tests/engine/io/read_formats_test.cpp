@@ -469,6 +469,30 @@ TEST_CASE("glTF: a buffer pointing to an external file is refused without readin
   }
 }
 
+TEST_CASE("glTF and GLB errors a service QA found unclear say what is wrong") {
+  const std::string glb = write_mesh(to_soup(test::make_icosphere(1)), Format::Glb);
+  // Cut short: tinygltf said "Invalid glTF binary."
+  CHECK_THAT(read_error(glb.substr(0, glb.size() - 100)),
+             Catch::Contains("GLB: the file is " + std::to_string(glb.size() - 100) + " bytes, but its header says " +
+                             std::to_string(glb.size())));
+  CHECK_THAT(read_error(glb.substr(0, 40)), Catch::Contains("GLB:") && Catch::Contains("cut short"));
+  // A JSON syntax error without the JSON library's tag ("[json.exception.parse_error.101]").
+  const std::string bad_json = read_error(R"({"asset":{"version":"2.0"},)");
+  CHECK_THAT(bad_json, Catch::StartsWith("glTF: "));
+  CHECK(bad_json.find("json.exception") == std::string::npos);
+  // A data: URI that is not base64 was "an external file 'data:...'".
+  PolygonSoup soup = to_soup(test::make_icosphere(0));
+  CHECK_THAT(read_error(test::write_gltf_data_uri(soup, "data:application/octet-stream,%00%01")),
+             Catch::Contains("not base64") && !Catch::Contains("external file"));
+  // Points only: "holds no vertices and no faces".
+  const std::string points = R"({"asset":{"version":"2.0"},"scene":0,"scenes":[{"nodes":[0]}],"nodes":[{"mesh":0}],
+    "meshes":[{"primitives":[{"attributes":{"POSITION":0},"mode":0}]}],
+    "accessors":[{"bufferView":0,"componentType":5126,"count":4,"type":"VEC3"}],
+    "bufferViews":[{"buffer":0,"byteLength":48}],
+    "buffers":[{"byteLength":48,"uri":"data:application/octet-stream;base64,)" + unit_square_base64() + R"("}]})";
+  CHECK(read_error(points) == "glTF: its primitives are points (mode 0), no triangles: there is no surface to remesh");
+}
+
 TEST_CASE("Format detection and names") {
   CHECK(parse_format("a/b/mesh.OBJ") == Format::Obj);
   CHECK(parse_format(".glb") == Format::Glb);

@@ -197,7 +197,7 @@ async function submit(e) {
   } catch (err) {
     $('submit-status').textContent = '';
     const name = state.file?.name || 'the file';
-    const size = /the result would have about (\d+) faces, more than the limit of (\d+)/.exec(err.message);
+    const size = /the result would have (about|over) (\d+) faces, more than the limit of (\d+)/.exec(err.message);
     if (err.status === 422 && err.fieldErrors.length) {
       // Complaints about the file go beside it (and by the button); the rest beside their fields.
       const about_file = err.fieldErrors.filter((f) => FILE_FIELDS.includes(f.field));
@@ -208,8 +208,8 @@ async function submit(e) {
           .join(' ') + ' Choose another file.', { focus: !others.length });
     } else if (err.status === 422) file_error(`The server could not read ${name}: ${err.message}. Fix the file or choose another one.`);
     else if (err.status === 413 && size) {
-      params.show_field_errors([{ field: 'emin', text: `e_min and e_max are so small that the result would have about ` +
-        `${readable(+size[1])} faces, more than this server's limit of ${readable(+size[2])}. Use a larger e_min and e_max.` }],
+      params.show_field_errors([{ field: 'emin', text: `e_min and e_max are so small that the result would have ${size[1]} ` +
+        `${readable(+size[2])} faces, more than this server's limit of ${readable(+size[3])}. Use a larger e_min and e_max.` }],
       { also: ['emax'] });
     } else if (err.status === 413)
       file_error(`${name} is too large for this server: ${readable_numbers(err.message)}. Choose a smaller mesh.`);
