@@ -455,6 +455,31 @@ void HttpServer::Impl::setup() {
       case 404: detail = "no such route: " + req.method + " " + req.path; break;
       case 413: detail = "the request body is too large"; break;
       case 400:
+        // A request line cpp-httplib refused before routing: what of it, when it can be told (it
+        // said the same for every cause).
+        if (!req.method.empty()) {
+          // TRACE and CONNECT parse, and reach no route.
+          static const std::set<std::string> served = {"GET", "HEAD", "POST", "PUT", "PATCH", "DELETE", "OPTIONS"};
+          if (!served.count(req.method)) {
+            std::string upper = req.method;
+            for (char& ch : upper) ch = static_cast<char>(std::toupper(static_cast<unsigned char>(ch)));
+            res.status = 501;
+            detail = "the method '" + req.method.substr(0, 40) +
+                     "' is not implemented here (GET, HEAD, POST, DELETE, OPTIONS" +
+                     (served.count(upper) ? "; methods are upper case" : "") + ")";
+            break;
+          }
+          if (!t_pre_routed && req.version != "HTTP/1.1" && req.version != "HTTP/1.0") {
+            res.status = 505;
+            detail = "the HTTP version '" + req.version.substr(0, 40) + "' is not supported: send HTTP/1.1";
+            break;
+          }
+        }
+        if (!t_pre_routed && req.method.empty()) {
+          detail = "malformed request: the request line does not parse as 'METHOD target HTTP/1.1' (each line "
+                   "of the request line and headers ends with CR LF)";
+          break;
+        }
         // cpp-httplib says no more than the status: name what makes a request unreadable.
         detail = "malformed request: a request line or header that does not parse as HTTP/1.1, a header line "
                  "longer than the server reads (8 KiB), or a body that does not match its Content-Length, "
@@ -467,6 +492,8 @@ void HttpServer::Impl::setup() {
       default: detail = remesh::api::status_title(res.status);
     }
     send_problem(res, make_problem(res.status, detail));
+    // The connection ends with these (the next bytes may not be a request): httplib kept it open.
+    if (res.status == 501 || res.status == 505) close_after(req, res);
     return httplib::Server::HandlerResponse::Handled;
   }));
   server.set_exception_handler([this](const httplib::Request& req, httplib::Response& res, std::exception_ptr ep) {
@@ -1099,14 +1126,15 @@ void HttpServer::Impl::result(const httplib::Request& req, httplib::Response& re
   }
   std::error_code ec;
   auto size = std::filesystem::file_size(path, ec);
-  if (ec || !std::filesystem::is_regular_file(path, ec)) {
+  // No result is 0 bytes: such a file was damaged in the data directory (it was served as a 200).
+  if (ec || !std::filesystem::is_regular_file(path, ec) || size == 0) {
     if (!jobs.record(rec->id)) {
       send_problem(res, 404, "the file is gone (the job was removed)");
       return;
     }
     log.error("handler", {str("path", req.path), str("job", rec->id), str("error", "missing " + path.string())});
-    send_problem(res, 500, "the job's " + mesh + "." + format +
-                               " file is missing from the service's data directory (removed or damaged there)");
+    send_problem(res, 500, "the job's " + mesh + "." + format + " file is " + (ec || size > 0 ? "missing" : "empty") +
+                               " in the service's data directory (removed or damaged there)");
     return;
   }
   std::string etag = "\"" + rec->id + "-" + mesh + "-" + format + "-" + std::to_string(size) + "\"";

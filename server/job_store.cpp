@@ -220,8 +220,12 @@ std::vector<JobStore::Loaded> JobStore::load_all(std::vector<std::string>& probl
       Loaded l{remesh::api::job_from_json(j), load_stats(name)};
       if (l.record.id != name) throw std::runtime_error("id does not match the directory");
       jobs.push_back(std::move(l));
+    } catch (const nlohmann::json::parse_error&) {
+      // In words, not the JSON library's ("[json.exception.parse_error.101] ...").
+      problems.push_back(name + ": its state.json does not parse as JSON (cut short or damaged); the job is not "
+                                "loaded, its files are kept");
     } catch (const std::exception& e) {
-      problems.push_back(name + ": " + e.what());
+      problems.push_back(name + ": " + e.what() + "; the job is not loaded, its files are kept");
     }
   }
   return jobs;

@@ -366,6 +366,17 @@ RawSoup read_gltf(std::string_view bytes, bool binary, const ReadOptions& option
          "; only embedded data (data: URIs or .glb) is accepted");
   if (!ok) fail(std::string(binary ? "GLB" : "glTF") + ": " + first_line(err));
 
+  // An extension the file requires changes how its data reads (EXT_meshopt_compression: the buffer
+  // views are compressed): read without it, the positions were garbage. Those about looks only
+  // (materials, textures, lights) leave the geometry as it is.
+  for (const std::string& ext : model.extensionsRequired) {
+    bool looks_only = false;
+    for (const char* prefix : {"KHR_materials_", "KHR_texture_", "KHR_lights_", "EXT_texture_"})
+      looks_only = looks_only || ext.starts_with(prefix);
+    if (!looks_only && ext != "KHR_draco_mesh_compression")  // Draco: named per primitive below
+      fail(std::string(binary ? "GLB" : "glTF") + ": it requires the extension " + quote(ext.substr(0, 64)) +
+           ", which this reader does not support");
+  }
   Collector collect(model, options, bytes.size());
   const int scene = model.defaultScene;
   if (scene >= 0 && static_cast<std::size_t>(scene) < model.scenes.size()) {

@@ -25,26 +25,36 @@ LoadedMesh read_mesh(std::string_view bytes, const ReadOptions& options) {
   // a binary STL's 80-byte header may start with any bytes.
   if (bytes.starts_with("\xEF\xBB\xBF") && *format != Format::Stl && *format != Format::Glb) bytes.remove_prefix(3);
   io::RawSoup soup;
-  switch (*format) {
-    case Format::Obj: soup = io::read_obj(bytes, options); break;
-    case Format::Off: soup = io::read_off(bytes, options); break;
-    case Format::Ply: soup = io::read_ply(bytes, options); break;
-    case Format::Stl: soup = io::read_stl(bytes, options); break;
-    case Format::Gltf: soup = io::read_gltf(bytes, false, options); break;
-    case Format::Glb: soup = io::read_gltf(bytes, true, options); break;
-    case Format::Xyz: throw MeshError("unsupported input format xyz (a point list has no faces)");
-    case Format::Lammps: throw MeshError("unsupported input format lammps (atoms and bonds, no faces)");
+  try {
+    switch (*format) {
+      case Format::Obj: soup = io::read_obj(bytes, options); break;
+      case Format::Off: soup = io::read_off(bytes, options); break;
+      case Format::Ply: soup = io::read_ply(bytes, options); break;
+      case Format::Stl: soup = io::read_stl(bytes, options); break;
+      case Format::Gltf: soup = io::read_gltf(bytes, false, options); break;
+      case Format::Glb: soup = io::read_gltf(bytes, true, options); break;
+      case Format::Xyz: throw MeshError("unsupported input format xyz (a point list has no faces)");
+      case Format::Lammps: throw MeshError("unsupported input format lammps (atoms and bonds, no faces)");
+    }
+  } catch (const MeshError& e) {
+    // Given as one format (a name, a format parameter, a content type) and refused by its reader,
+    // while the content is clearly another: say so (an OFF file uploaded as .stl got only the STL
+    // reader's complaint).
+    const std::optional<Format> sniffed = options.format ? detect_format(bytes) : std::nullopt;
+    if (!sniffed || sniffed == format) throw;
+    throw MeshError(std::string(e.what()) + " (read as " + std::string(format_name(*format)) +
+                    ", the format it was given as; its content looks like " + std::string(format_name(*sniffed)) + ")");
   }
   // The OBJ reader passes over lines it does not know: a PLY or OFF file under an .obj name reads
   // as empty. Say what the content looks like instead of "no vertices and no faces".
   if (soup.points.empty() && soup.face_count() == 0 && options.format) {
     const std::optional<Format> sniffed = detect_format(bytes);
     if (sniffed && sniffed != format)
-      throw MeshError("read as " + std::string(format_name(*format)) + " (its name or format parameter) it holds " +
+      throw MeshError("read as " + std::string(format_name(*format)) + " (the format it was given as) it holds " +
                       "no vertices and no faces, but its content looks like " + std::string(format_name(*sniffed)));
     // Nor is a file with a NUL byte OBJ text: an image or another binary file under an .obj name.
     if (!sniffed && *format == Format::Obj && bytes.find('\0') != std::string_view::npos)
-      throw MeshError("read as obj (its name or format parameter) it holds no vertices and no faces: its content "
+      throw MeshError("read as obj (the format it was given as) it holds no vertices and no faces: its content "
                       "is binary data, not OBJ text nor any mesh format this reader knows");
   }
   LoadedMesh out{TriMesh(), *format, std::move(soup.repairs)};

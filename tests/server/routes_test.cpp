@@ -933,7 +933,9 @@ TEST_CASE("remeshd: metrics label a request's method from a fixed set", "[server
   for (const std::string& method : {std::string("BREW"), long_method, std::string("get")}) {
     const std::string answer =
         raw_exchange(d.port(), method + " /healthz HTTP/1.1\r\nHost: x\r\nConnection: close\r\n\r\n", 10);
-    CHECK(answer.rfind("HTTP/1.1 400", 0) == 0);
+    CHECK(answer.rfind("HTTP/1.1 501", 0) == 0);  // a method not implemented (it was a vague 400)
+    CHECK(answer.find(method.substr(0, 40) + "' is not implemented") != std::string::npos);
+    CHECK(answer.find(std::string(41, 'Q')) == std::string::npos);  // the name cut short
   }
   CHECK(c.Get("/healthz")->status == 200);
   auto metrics = c.Get("/metrics");
@@ -942,7 +944,7 @@ TEST_CASE("remeshd: metrics label a request's method from a fixed set", "[server
   CHECK(text.find("BREW") == std::string::npos);
   CHECK(text.find("QQQQ") == std::string::npos);
   CHECK(text.find("method=\"get\"") == std::string::npos);
-  CHECK(text.find("remeshd_http_requests_total{method=\"other\",route=\"static\",status=\"400\"} 3") != std::string::npos);
+  CHECK(text.find("remeshd_http_requests_total{method=\"other\",route=\"static\",status=\"501\"} 3") != std::string::npos);
   CHECK(text.find("remeshd_http_requests_total{method=\"GET\",route=\"/healthz\",status=\"200\"} 1") != std::string::npos);
   // A request answered before routing is timed from when it was read, not from the thread's last
   // request: every request here took well under 10 s.
@@ -1102,8 +1104,14 @@ TEST_CASE("remeshd: answers a service QA pass found wrong or unclear", "[server]
   auto missing = c.Get(result.c_str());
   REQUIRE(missing);
   CHECK(missing->status == 500);
-  CHECK(body_of(missing)["detail"].get<std::string>().find("missing from the service's data directory") !=
+  CHECK(body_of(missing)["detail"].get<std::string>().find("missing in the service's data directory") !=
         std::string::npos);
+  // An empty one (no result is 0 bytes) was served as a 200 with no body.
+  std::ofstream(data / "jobs" / id / "dual.glb", std::ios::trunc).close();
+  auto empty = c.Get(("/api/v1/jobs/" + id + "/result?mesh=dual&format=glb").c_str());
+  REQUIRE(empty);
+  CHECK(empty->status == 500);
+  CHECK(body_of(empty)["detail"].get<std::string>().find("dual.glb file is empty") != std::string::npos);
   // A file made on demand from files gone: 500 naming no path on the server (it gave the path).
   std::filesystem::remove(data / "jobs" / id / "upload");
   auto no_upload = c.Get(("/api/v1/jobs/" + id + "/result?mesh=input&format=ply").c_str());
@@ -1111,6 +1119,21 @@ TEST_CASE("remeshd: answers a service QA pass found wrong or unclear", "[server]
   CHECK(no_upload->status == 500);
   CHECK(no_upload->body.find(tmp.path.string()) == std::string::npos);
   CHECK(no_upload->body.find("/jobs/") == std::string::npos);
+
+  // A request line with a method or version not served was one vague 400 for every cause, its
+  // connection kept: the method or version named, 501 and 505, and the connection ends.
+  for (const auto& [line, status, words] :
+       {std::tuple{std::string("PROPFIND / HTTP/1.1"), 501, std::string("'PROPFIND' is not implemented")},
+        {"TRACE / HTTP/1.1", 501, "'TRACE' is not implemented"},
+        {"get /healthz HTTP/1.1", 501, "methods are upper case"},
+        {"GET /healthz HTTP/2.0", 505, "'HTTP/2.0' is not supported"}}) {
+    CAPTURE(line);
+    const std::string answer =
+        raw_exchange(d.port(), line + "\r\nHost: x\r\n\r\nGET /healthz HTTP/1.1\r\nHost: x\r\n\r\n", 10);
+    CHECK(answer.rfind("HTTP/1.1 " + std::to_string(status), 0) == 0);
+    CHECK(answer.find(words) != std::string::npos);
+    CHECK(answer.find("HTTP/1.1 200") == std::string::npos);  // the request behind it is not read
+  }
 
   // A static file named as a directory was served (/app.js/).
   CHECK(c.Get("/index.html")->status == 200);

@@ -184,6 +184,19 @@ TEST_CASE("JobStore: atomic job directories, torn stats lines, bad ids", "[serve
   CHECK_FALSE(fs::exists(root / "jobs" / ".tmp-abc"));
   std::vector<std::string> problems;
   CHECK(again.load_all(problems).size() == 1);
+  // A state.json cut short: skipped, said in words (it was the JSON library's text), files kept.
+  const std::string damaged(32, 'a');
+  fs::create_directories(root / "jobs" / damaged);
+  std::ofstream(root / "jobs" / damaged / "state.json") << "{\"id\":\"aaaa";
+  problems.clear();
+  CHECK(again.load_all(problems).size() == 1);
+  REQUIRE(problems.size() == 1);
+  CHECK_THAT(problems[0], Catch::StartsWith(damaged) && Catch::Contains("does not parse as JSON") &&
+                              !Catch::Contains("json.exception"));
+  CHECK(fs::exists(root / "jobs" / damaged / "state.json"));
+  // A missing upload is named without the path on the server (it reaches a job's error).
+  CHECK_THROWS_WITH(again.read_upload(damaged), Catch::Contains("stored upload cannot be read") &&
+                                                    !Catch::Contains(root.string()));
   fs::remove_all(root);
 }
 

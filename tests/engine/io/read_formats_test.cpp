@@ -491,6 +491,19 @@ TEST_CASE("glTF and GLB errors a service QA found unclear say what is wrong") {
     "bufferViews":[{"buffer":0,"byteLength":48}],
     "buffers":[{"byteLength":48,"uri":"data:application/octet-stream;base64,)" + unit_square_base64() + R"("}]})";
   CHECK(read_error(points) == "glTF: its primitives are points (mode 0), no triangles: there is no surface to remesh");
+  // A required extension that changes how the data reads (meshopt: compressed buffer views) was
+  // passed over, the positions read as they lay; one about looks only is read past.
+  auto requiring = [](const std::string& ext) {
+    return R"({"asset":{"version":"2.0"},"extensionsUsed":[")" + ext + R"("],"extensionsRequired":[")" + ext +
+           R"("],"scene":0,"scenes":[{"nodes":[0]}],"nodes":[{"mesh":0}],
+      "meshes":[{"primitives":[{"attributes":{"POSITION":0},"mode":5}]}],
+      "accessors":[{"bufferView":0,"componentType":5126,"count":4,"type":"VEC3"}],
+      "bufferViews":[{"buffer":0,"byteLength":48}],
+      "buffers":[{"byteLength":48,"uri":"data:application/octet-stream;base64,)" + unit_square_base64() + R"("}]})";
+  };
+  CHECK(read_error(requiring("EXT_meshopt_compression")) ==
+        "glTF: it requires the extension 'EXT_meshopt_compression', which this reader does not support");
+  CHECK(read_error(requiring("KHR_materials_emissive_strength")).empty());
 }
 
 TEST_CASE("Format detection and names") {
@@ -612,6 +625,13 @@ TEST_CASE("A file given under another format's name says what its content looks 
   // An image under a .obj name: binary data, said to be so (it was "no vertices and no faces").
   const std::string png("\x89PNG\r\n\x1a\n\0\0\0\rIHDR\0\0\0\x10\0\0\0\x10\x08\x06\0\0\0", 33);
   CHECK_THROWS_WITH(read_as(png, Format::Obj), Catch::Contains("its content is binary data, not OBJ text"));
+  // Refused by another format's reader: its complaint, and what the content looks like (an OFF file
+  // given as STL or GLB got the reader's complaint alone).
+  for (Format given : {Format::Stl, Format::Glb, Format::Ply}) {
+    CAPTURE(format_name(given));
+    CHECK_THROWS_WITH(read_as(off, given), Catch::Contains("read as " + std::string(format_name(given))) &&
+                                               Catch::Contains("its content looks like off"));
+  }
 }
 
 TEST_CASE("GLB: accessor and bufferView offsets whose sums wrap round 2^64 are refused, not read") {
