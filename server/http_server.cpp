@@ -457,7 +457,7 @@ void HttpServer::Impl::setup() {
       case 400:
         // A request line cpp-httplib refused before routing: what of it, when it can be told (it
         // said the same for every cause).
-        if (!req.method.empty()) {
+        if (!req.method.empty() && !req.version.empty()) {  // a request line of three parts
           // TRACE and CONNECT parse, and reach no route.
           static const std::set<std::string> served = {"GET", "HEAD", "POST", "PUT", "PATCH", "DELETE", "OPTIONS"};
           if (!served.count(req.method)) {
@@ -475,7 +475,7 @@ void HttpServer::Impl::setup() {
             break;
           }
         }
-        if (!t_pre_routed && req.method.empty()) {
+        if (!t_pre_routed && (req.method.empty() || req.version.empty())) {
           detail = "malformed request: the request line does not parse as 'METHOD target HTTP/1.1' (each line "
                    "of the request line and headers ends with CR LF)";
           break;
@@ -492,8 +492,9 @@ void HttpServer::Impl::setup() {
       default: detail = remesh::api::status_title(res.status);
     }
     send_problem(res, make_problem(res.status, detail));
-    // The connection ends with these (the next bytes may not be a request): httplib kept it open.
-    if (res.status == 501 || res.status == 505) close_after(req, res);
+    // The connection ends with these (the next bytes may not be a request): httplib kept it open
+    // after a request it could not read, for 5 s, and read what followed as a request.
+    if (!t_pre_routed || res.status == 501 || res.status == 505) close_after(req, res);
     return httplib::Server::HandlerResponse::Handled;
   }));
   server.set_exception_handler([this](const httplib::Request& req, httplib::Response& res, std::exception_ptr ep) {
