@@ -49,9 +49,13 @@ std::optional<double> opt_time(const json& j, const char* key) {
   return parse_iso8601(it->get<std::string>());
 }
 
-json format_links(const std::string& base, const char* mesh, const std::vector<std::string>& formats) {
+/// The links of `mesh`'s files in `formats`, but those in `unwritable` ("dual.glb").
+json format_links(const std::string& base, const std::string& mesh, const std::vector<std::string>& formats,
+                  const std::vector<std::string>& unwritable) {
   json links = json::object();
-  for (const std::string& f : formats) links[f] = base + "/result?mesh=" + mesh + "&format=" + f;
+  for (const std::string& f : formats)
+    if (std::find(unwritable.begin(), unwritable.end(), mesh + "." + f) == unwritable.end())
+      links[f] = base + "/result?mesh=" + mesh + "&format=" + f;
   return links;
 }
 
@@ -182,8 +186,8 @@ json job_to_json(const JobRecord& job, std::string_view prefix, double now) {
                 {"stats", base + "/stats"},
                 {"input", base + "/result?mesh=input&format=glb"}};
   if (job.state == JobState::Succeeded)
-    links["results"] = {{"remeshed", format_links(base, "remeshed", remeshed_formats())},
-                        {"dual", format_links(base, "dual", dual_formats())}};
+    links["results"] = {{"remeshed", format_links(base, "remeshed", remeshed_formats(), job.unwritable)},
+                        {"dual", format_links(base, "dual", dual_formats(), job.unwritable)}};
   return json{
       {"id", job.id},
       {"state", state_name(job.state)},
@@ -204,6 +208,7 @@ json job_to_json(const JobRecord& job, std::string_view prefix, double now) {
       {"crossing_pairs", job.crossing_pairs ? json(*job.crossing_pairs) : json(nullptr)},
       // Known once the run has succeeded, as crossing_pairs (null before: it read false, "no layers").
       {"layered", job.state == JobState::Succeeded ? json(job.layered) : json(nullptr)},
+      {"unwritable", job.unwritable},
       {"triangles", job.triangles ? json(*job.triangles) : json(nullptr)},
       {"seconds_by_step", job.seconds_by_step ? step_seconds_to_json(*job.seconds_by_step) : json(nullptr)},
       {"dual", job.dual ? dual_to_json(*job.dual) : json(nullptr)},
@@ -261,6 +266,9 @@ JobRecord job_from_json(const json& j) {
     if (const auto c = j.find("crossing_pairs"); c != j.end() && !c->is_null())
       job.crossing_pairs = c->get<std::size_t>();
     if (const auto l = j.find("layered"); l != j.end() && l->is_boolean()) job.layered = l->get<bool>();
+    if (const auto u = j.find("unwritable"); u != j.end() && u->is_array())
+      for (const json& name : *u)
+        if (name.is_string()) job.unwritable.push_back(name.get<std::string>());
     // Absent in documents written before the field existed.
     if (const auto t = j.find("triangles"); t != j.end() && !t->is_null()) job.triangles = t->get<TriangleQuality>();
     if (const auto t = j.find("seconds_by_step"); t != j.end() && !t->is_null())

@@ -55,6 +55,9 @@ struct JobRecord {
   std::optional<std::size_t> crossing_pairs;
   /// Of the result: it lies over itself throughout, its crossing pairs not counted (Result::layered).
   bool layered = false;
+  /// Of the result: the files its formats cannot hold ("remeshed.stl", "dual.glb": float32 past
+  /// 3.4e38), made on demand only to be refused; their links are left out.
+  std::vector<std::string> unwritable;
   /// Of the result: its triangles' shapes (Result::triangles); nullopt until the job succeeded.
   std::optional<TriangleQuality> triangles;
   /// Of the run that succeeded: where its time went, step by step (Result::phases), and the

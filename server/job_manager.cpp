@@ -334,6 +334,7 @@ void JobManager::run(const std::string& id) {
       job->record.crossing_pairs = result.crossing_pairs;
       job->record.layered = result.layered;
       job->record.triangles = result.triangles;
+      job->record.unwritable = out.unwritable;
       job->record.dual = out.dual;
       job->record.seconds_by_step = remesh::api::JobRecord::StepSeconds{result.phases, result.seconds};
     }

@@ -53,6 +53,7 @@ RunOutput run_job(const remesh::api::JobRecord& job, std::string upload, unsigne
       try {
         bytes = remesh::write_mesh(m, format_of(f));
       } catch (const std::range_error&) {
+        out.unwritable.push_back(stem + "." + f);
         continue;
       }
       write(stem + "." + f, bytes);

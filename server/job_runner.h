@@ -6,6 +6,7 @@
 #include <functional>
 #include <stop_token>
 #include <string>
+#include <vector>
 #include <string_view>
 
 #include "api/job.h"
@@ -19,6 +20,8 @@ struct RunOutput {
   /// Cancelled also when a stop came during the dual's relaxation.
   remesh::Result result;
   remesh::DualStats dual;  ///< the dual's, against [e_min, e_max] / sqrt(3) (not when cancelled)
+  /// The result files its formats cannot hold ("remeshed.stl": float32 past 3.4e38), not written.
+  std::vector<std::string> unwritable;
 };
 
 /// Receives each result file as soon as it is serialised: its name ("remeshed.obj", "dual.glb",

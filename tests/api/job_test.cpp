@@ -128,6 +128,19 @@ TEST_CASE("job document: fields, links only when succeeded, round trip", "[api][
   CHECK(doc["links"]["results"]["remeshed"].size() == 6);  // obj glb ply off stl lammps
   CHECK(doc["links"]["results"]["dual"].size() == 6);      // obj glb ply off xyz lammps
   CHECK(doc["links"]["results"]["dual"]["xyz"] == "/api/v1/jobs/" + r.id + "/result?mesh=dual&format=xyz");
+  CHECK(doc["unwritable"] == json::array());
+  {
+    // Files the formats cannot hold are named, and their links left out (all were linked).
+    JobRecord far = r;
+    far.unwritable = {"remeshed.stl", "dual.glb"};
+    const json far_doc = job_to_json(far, "/api/v1", r.created_at + 100);
+    CHECK(far_doc["unwritable"] == json::array({"remeshed.stl", "dual.glb"}));
+    CHECK(far_doc["links"]["results"]["remeshed"].size() == 5);
+    CHECK_FALSE(far_doc["links"]["results"]["remeshed"].contains("stl"));
+    CHECK(far_doc["links"]["results"]["remeshed"].contains("glb"));
+    CHECK_FALSE(far_doc["links"]["results"]["dual"].contains("glb"));
+    CHECK(job_from_json(far_doc).unwritable == far.unwritable);  // stored and read back
+  }
   CHECK(doc["links"]["results"]["remeshed"]["lammps"] ==
         "/api/v1/jobs/" + r.id + "/result?mesh=remeshed&format=lammps");
 

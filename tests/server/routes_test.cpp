@@ -269,6 +269,13 @@ TEST_CASE("remeshd: a result float32 cannot hold succeeds, and its STL and GLB a
   const json done = wait_final(c, body_of(r)["id"]);
   REQUIRE(done["state"] == "succeeded");
   const std::string base = "/api/v1/jobs/" + done["id"].get<std::string>() + "/result";
+  // The job names those files and links only the others (it linked all, each to a 422).
+  CHECK(done["unwritable"] == json::array({"remeshed.glb", "remeshed.stl", "dual.glb"}));
+  CHECK(done["links"]["results"]["remeshed"].contains("obj"));
+  CHECK_FALSE(done["links"]["results"]["remeshed"].contains("stl"));
+  CHECK_FALSE(done["links"]["results"]["remeshed"].contains("glb"));
+  CHECK_FALSE(done["links"]["results"]["dual"].contains("glb"));
+  CHECK(done["links"]["results"]["dual"].contains("xyz"));
   auto obj = c.Get(base + "?format=obj");
   REQUIRE(obj);
   CHECK(obj->status == 200);

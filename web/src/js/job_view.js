@@ -319,8 +319,12 @@ export class JobView {
       box.append(g);
     };
     if (job.state === 'succeeded') {
+      // Not the files the formats cannot hold (float32 STL and GLB of a mesh past 3.4e38): the
+      // server names them, and a download of one is refused.
+      const unwritable = new Set(job.unwritable || []);
       for (const mesh of ['remeshed', 'dual'])
-        group(mesh, RESULT_FORMATS[mesh].map((f) => [f, api.result_url(job.id, mesh, f), `${base}_${mesh}.${f}`]));
+        group(mesh, RESULT_FORMATS[mesh].filter((f) => !unwritable.has(`${mesh}.${f}`))
+          .map((f) => [f, api.result_url(job.id, mesh, f), `${base}_${mesh}.${f}`]));
     }
     group('statistics', [['csv', api.stats_csv_url(job.id), `${base}_stats.csv`]]);
   }
