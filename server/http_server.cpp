@@ -641,7 +641,8 @@ httplib::Server::HandlerResponse HttpServer::Impl::pre_route(const httplib::Requ
   }
   // A header that decides the answer, given twice: httplib took the first (Authorization right then
   // wrong was let in, a proxy in front may take the last). Refused, naming it.
-  for (const char* name : {"Authorization", "Range", "If-Range", "If-None-Match", "Last-Event-ID", "Content-Type",
+  // (If-None-Match is a list: given twice, it is one list of both; the download joins them.)
+  for (const char* name : {"Authorization", "Range", "If-Range", "Last-Event-ID", "Content-Type",
                            "Content-Encoding"}) {
     if (const std::size_t n = req.get_header_value_count(name); n > 1) {
       if (has_body(req)) res.set_header("Connection", "close");  // its body is not read
@@ -1141,7 +1142,10 @@ void HttpServer::Impl::result(const httplib::Request& req, httplib::Response& re
   std::string etag = "\"" + rec->id + "-" + mesh + "-" + format + "-" + std::to_string(size) + "\"";
   res.set_header("ETag", etag);
   res.set_header("Cache-Control", "private, no-cache");
-  std::string inm = req.get_header_value("If-None-Match");
+  // A list, possibly over several header lines (RFC 9110 5.3): all of them.
+  std::string inm;
+  for (std::size_t i = 0; i < req.get_header_value_count("If-None-Match"); ++i)
+    inm += (i ? ", " : "") + req.get_header_value("If-None-Match", i);
   if (!inm.empty() && (inm == "*" || inm.find(etag) != std::string::npos)) {
     res.status = 304;
     return;
