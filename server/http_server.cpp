@@ -392,6 +392,8 @@ struct HttpServer::Impl {
   void static_files(const httplib::Request& req, httplib::Response& res);
   /// The job named by the first path parameter, or a 404 answer.
   std::optional<JobRecord> find_job(const httplib::Request& req, httplib::Response& res);
+  /// Has job `id` been removed, or is it being removed (its entry or its stored state gone)?
+  bool removed(const std::string& id) const;
   json document(const JobRecord& r) const { return remesh::api::job_to_json(r, kPrefix, remesh::api::now_seconds()); }
 };
 
@@ -458,6 +460,12 @@ void HttpServer::Impl::setup() {
         // A request line cpp-httplib refused before routing: what of it, when it can be told (it
         // said the same for every cause).
         if (!req.method.empty() && !req.version.empty()) {  // a request line of three parts
+          // The version first: HTTP/2's preface (PRI * HTTP/2.0) is a version not served.
+          if (!t_pre_routed && req.version != "HTTP/1.1" && req.version != "HTTP/1.0") {
+            res.status = 505;
+            detail = "the HTTP version '" + req.version.substr(0, 40) + "' is not supported: send HTTP/1.1";
+            break;
+          }
           // TRACE and CONNECT parse, and reach no route.
           static const std::set<std::string> served = {"GET", "HEAD", "POST", "PUT", "PATCH", "DELETE", "OPTIONS"};
           if (!served.count(req.method)) {
@@ -467,11 +475,6 @@ void HttpServer::Impl::setup() {
             detail = "the method '" + req.method.substr(0, 40) +
                      "' is not implemented here (GET, HEAD, POST, DELETE, OPTIONS" +
                      (served.count(upper) ? "; methods are upper case" : "") + ")";
-            break;
-          }
-          if (!t_pre_routed && req.version != "HTTP/1.1" && req.version != "HTTP/1.0") {
-            res.status = 505;
-            detail = "the HTTP version '" + req.version.substr(0, 40) + "' is not supported: send HTTP/1.1";
             break;
           }
         }
@@ -517,6 +520,7 @@ void HttpServer::Impl::setup() {
                          num("status", res.status), num("ms", std::round(secs * 1e5) / 100),
                          num("bytes", static_cast<double>(body_bytes(res) + t_streamed_bytes)),
                          str("remote", req.remote_addr)});
+    t_streamed_bytes = 0;  // a request refused before pre_route is logged next on this thread
   });
 
   const std::string jobs_path = std::string(kPrefix) + "/jobs";
@@ -579,7 +583,9 @@ httplib::Server::HandlerResponse HttpServer::Impl::pre_route(const httplib::Requ
   auto& request = const_cast<httplib::Request&>(req);
   request.params = parse_query(req.target);
   t_range.reset();
-  if (req.ranges.size() == 1 && (req.method == "GET" || req.method == "HEAD")) t_range = req.ranges.front();
+  // One range of one Range header; any other is ignored (the whole answer; RFC 9110 14.2).
+  if (req.ranges.size() == 1 && req.get_header_value_count("Range") == 1 && (req.method == "GET" || req.method == "HEAD"))
+    t_range = req.ranges.front();
   request.ranges.clear();
   // Both framings: RFC 9112 6.3 has a server refuse the message and close the connection (a
   // proxy in front may have read it the other way: the shape of request smuggling).
@@ -642,8 +648,8 @@ httplib::Server::HandlerResponse HttpServer::Impl::pre_route(const httplib::Requ
   // A header that decides the answer, given twice: httplib took the first (Authorization right then
   // wrong was let in, a proxy in front may take the last). Refused, naming it.
   // (If-None-Match is a list: given twice, it is one list of both; the download joins them.)
-  for (const char* name : {"Authorization", "Range", "If-Range", "Last-Event-ID", "Content-Type",
-                           "Content-Encoding"}) {
+  // (Range given twice is ignored, as any range not of one part: the whole answer.)
+  for (const char* name : {"Authorization", "If-Range", "Last-Event-ID", "Content-Type"}) {
     if (const std::size_t n = req.get_header_value_count(name); n > 1) {
       if (has_body(req)) res.set_header("Connection", "close");  // its body is not read
       send_problem(res, 400, std::string("malformed request: the header ") + name + " is given " + std::to_string(n) +
@@ -653,16 +659,35 @@ httplib::Server::HandlerResponse HttpServer::Impl::pre_route(const httplib::Requ
   }
   // A body coding cpp-httplib 0.11 does not decode (zstd, compress, a list) it passed on as it came:
   // the job was made of the coded bytes. It decodes gzip, deflate and br.
-  // It matches the name exactly: "GZIP" was passed on too.
-  if (req.has_header("Content-Encoding")) {
-    const std::string coding = req.get_header_value("Content-Encoding");
-    if (coding != "gzip" && coding != "deflate" && coding != "br" && coding != "identity") {
-      if (has_body(req)) res.set_header("Connection", "close");  // its body is not read
-      send_problem(res, 415, "Content-Encoding '" + coding.substr(0, 40) +
-                                 "' is not supported: send the body as it is, or coded with one of gzip, deflate, br "
-                                 "(in lower case)");
+  // It matches the name exactly ("GZIP" was passed on too): the coding is named to it as it knows
+  // it (RFC 9110 8.4.1: any case; x-gzip is gzip). Only for a body: a GET saying "UTF-8" there is
+  // served as before.
+  if (has_body(req) && req.has_header("Content-Encoding")) {
+    std::string list;
+    for (std::size_t i = 0; i < req.get_header_value_count("Content-Encoding"); ++i)
+      list += (i ? "," : "") + req.get_header_value("Content-Encoding", i);
+    std::vector<std::string> codings;
+    for (std::size_t begin = 0; begin <= list.size();) {
+      const std::size_t end = std::min(list.find(',', begin), list.size());
+      std::string coding = list.substr(begin, end - begin);
+      begin = end + 1;
+      coding.erase(0, coding.find_first_not_of(" \t"));
+      coding.erase(coding.find_last_not_of(" \t") + 1);
+      for (char& ch : coding) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
+      if (coding == "x-gzip") coding = "gzip";
+      if (!coding.empty() && coding != "identity") codings.push_back(coding);
+    }
+    const bool known = codings.size() == 1 && (codings[0] == "gzip" || codings[0] == "deflate" || codings[0] == "br");
+    if (codings.size() > 1 || (codings.size() == 1 && !known)) {
+      res.set_header("Connection", "close");  // its body is not read
+      send_problem(res, 415, "Content-Encoding '" + list.substr(0, 40) +
+                                 "' is not supported: send the body as it is, or coded once with one of gzip, "
+                                 "deflate, br");
       return httplib::Server::HandlerResponse::Handled;
     }
+    auto& headers = const_cast<httplib::Request&>(req).headers;
+    headers.erase("Content-Encoding");
+    if (known) headers.emplace("Content-Encoding", codings[0]);
   }
   // cpp-httplib 0.11 reads no body for GET, HEAD and OPTIONS: the bytes of one would be read as the
   // next request on the connection (review: GET /healthz with a body that was 'GET /metrics' served
@@ -756,6 +781,11 @@ void HttpServer::Impl::health(const httplib::Request&, httplib::Response& res) {
              {"queue_depth", g.queue_depth},
              {"jobs", total},
              {"event_streams", streams.load()}});
+}
+
+bool HttpServer::Impl::removed(const std::string& id) const {
+  // The job's directory goes before its entry (expiry, the data cap): either means removed.
+  return !jobs.record(id) || !jobs.stored(id);
 }
 
 std::optional<JobRecord> HttpServer::Impl::find_job(const httplib::Request& req, httplib::Response& res) {
@@ -898,10 +928,12 @@ void HttpServer::Impl::post_job(const httplib::Request& req, httplib::Response& 
   for (const std::string& name : other_parts) {
     const auto& names = remesh::param_names();
     const bool param = std::find(names.begin(), names.end(), name) != names.end();
-    errors.push_back({name.substr(0, 64), param ? "is a part of its own: job parameters go in the JSON part 'params' "
-                                                  "(or all in the query)"
-                                                : "unknown part: a job takes a file part 'mesh' and a JSON part "
-                                                  "'params'"});
+    errors.push_back({name.substr(0, 64),
+                      param ? "is a part of its own: job parameters go in the JSON part 'params' (or all in the query)"
+                      : name == "format" || name == "filename"
+                          ? "is a part of its own: it goes in the query (?" + name + "=...), or comes from the mesh "
+                                                                                     "part's file name"
+                          : "unknown part: a job takes a file part 'mesh' and a JSON part 'params'"});
   }
   if (req.is_multipart_form_data() && mesh_parts == 0) errors.push_back({"mesh", "is required (a file field named 'mesh')"});
   else if (body.empty()) errors.push_back({"mesh", "is empty"});
@@ -1117,7 +1149,7 @@ void HttpServer::Impl::result(const httplib::Request& req, httplib::Response& re
     return;
   } catch (const std::exception& e) {
     // Deleted meanwhile (its directory went while the file was made): a 404, as a moment later.
-    if (!jobs.record(rec->id)) {
+    if (removed(rec->id)) {
       send_problem(res, 404, "the job was removed while its file was being made");
       return;
     }
@@ -1126,19 +1158,30 @@ void HttpServer::Impl::result(const httplib::Request& req, httplib::Response& re
     send_problem(res, 500, "cannot make the " + format + " file of this job (the service's log says why)");
     return;
   }
-  std::error_code ec;
-  auto size = std::filesystem::file_size(path, ec);
+  // Read once: a job removed meanwhile (DELETE, expiry, the data cap, which remove the files before
+  // the job) takes them at any moment. (Read after a size check, the file could go between: a 500
+  // naming its path.)
+  std::string bytes;
+  try {
+    if (std::filesystem::is_regular_file(path)) bytes = read_file(path);
+  } catch (const std::exception&) {
+    bytes.clear();
+  }
   // No result is 0 bytes: such a file was damaged in the data directory (it was served as a 200).
-  if (ec || !std::filesystem::is_regular_file(path, ec) || size == 0) {
-    if (!jobs.record(rec->id)) {
+  if (bytes.empty()) {
+    if (removed(rec->id)) {
       send_problem(res, 404, "the file is gone (the job was removed)");
       return;
     }
-    log.error("handler", {str("path", req.path), str("job", rec->id), str("error", "missing " + path.string())});
-    send_problem(res, 500, "the job's " + mesh + "." + format + " file is " + (ec || size > 0 ? "missing" : "empty") +
+    std::error_code ec;
+    const bool exists = std::filesystem::exists(path, ec);
+    log.error("handler", {str("path", req.path), str("job", rec->id),
+                          str("error", (exists ? "empty or unreadable " : "missing ") + path.string())});
+    send_problem(res, 500, "the job's " + mesh + "." + format + " file is " + (exists ? "empty or unreadable" : "missing") +
                                " in the service's data directory (removed or damaged there)");
     return;
   }
+  const std::size_t size = bytes.size();
   std::string etag = "\"" + rec->id + "-" + mesh + "-" + format + "-" + std::to_string(size) + "\"";
   res.set_header("ETag", etag);
   res.set_header("Cache-Control", "private, no-cache");
@@ -1150,7 +1193,6 @@ void HttpServer::Impl::result(const httplib::Request& req, httplib::Response& re
     res.status = 304;
     return;
   }
-  std::string bytes = read_file(path);
   res.set_header("Content-Disposition",
                  remesh::api::content_disposition("attachment", rec->filename, "-" + mesh + "." + format));
   res.set_header("Accept-Ranges", "bytes");

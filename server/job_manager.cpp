@@ -8,6 +8,7 @@
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
+#include <functional>
 #include <mutex>
 #include <stop_token>
 #include <thread>
@@ -248,20 +249,32 @@ void JobManager::run(const std::string& id) {
     record = job->record;
     token = job->stop.get_token();
   }
-  auto finish = [&](JobState state) {
+  // Ends the run in `state`; `fill` (under the same lock) writes a successful run's figures into
+  // the record. A run that succeeded while a DELETE was answered `cancelling` (after the run's last
+  // check for a stop, while its results were written) ends cancelled instead, decided under the
+  // lock the DELETE takes: it ended `succeeded` (a service QA finding), and checked apart from
+  // this lock a DELETE could still come between. Returns the state it ended in.
+  auto finish = [&](JobState state, const std::function<void(JobRecord&)>& fill = {}) {
     std::lock_guard lock(mutex_);
     --busy_;
+    if (state == JobState::Succeeded && job->record.state == JobState::Cancelling) {
+      state = JobState::Cancelled;
+      job->record.outcome = "cancelled";
+    } else if (fill) {
+      fill(job->record);
+    }
     if (job->interrupted) {
       if (state == JobState::Cancelled && job->record.state == JobState::Running) {
         // Stopped by the shutdown, which took the run back already (shutdown).
         log_.info("job", {str("job", id), str("interrupted", "shutdown"),
                           str("state", "running (re-queued on start)")});
-        return;
+        return JobState::Running;
       }
       // It ended anyway (finished, failed, or cancelled by the user): the run counts.
       ++job->record.attempts;
     }
     transition(*job, state);
+    return state;
   };
   try {
     std::string upload = store_.read_upload(id);
@@ -304,6 +317,7 @@ void JobManager::run(const std::string& id) {
       }
       log_.warn("job", {str("job", id), str("stopped", "time limit")});
       finish(JobState::Failed);
+      store_.remove_results(id);  // those written before the stop (the remeshed mesh's, say)
       return;
     }
     if (result.outcome == remesh::Outcome::Cancelled) {
@@ -311,34 +325,22 @@ void JobManager::run(const std::string& id) {
         std::lock_guard lock(mutex_);
         job->record.outcome = "cancelled";
       }
-      finish(JobState::Cancelled);
+      if (finish(JobState::Cancelled) == JobState::Cancelled) store_.remove_results(id);
       return;
     }
-    bool cancelled_late = false;
-    {
-      // Cancelled after the run's last check for a stop (while its results were written): the
-      // DELETE was answered `cancelling`, so the job ends cancelled, as one stopped sooner does
-      // (its files are not served: results are served only for a job that succeeded).
-      std::lock_guard lock(mutex_);
-      cancelled_late = job->record.state == JobState::Cancelling;
-      if (cancelled_late) job->record.outcome = "cancelled";
-    }
-    if (cancelled_late) {
-      finish(JobState::Cancelled);
-      return;
-    }
-    {
-      std::lock_guard lock(mutex_);
-      job->record.outcome = std::string(remesh::api::outcome_name(result.outcome));
-      job->record.thin_parts = result.thin;
-      job->record.crossing_pairs = result.crossing_pairs;
-      job->record.layered = result.layered;
-      job->record.triangles = result.triangles;
-      job->record.unwritable = out.unwritable;
-      job->record.dual = out.dual;
-      job->record.seconds_by_step = remesh::api::JobRecord::StepSeconds{result.phases, result.seconds};
-    }
-    finish(JobState::Succeeded);
+    const JobState ended = finish(JobState::Succeeded, [&](JobRecord& r) {
+      r.outcome = std::string(remesh::api::outcome_name(result.outcome));
+      r.thin_parts = result.thin;
+      r.crossing_pairs = result.crossing_pairs;
+      r.layered = result.layered;
+      r.triangles = result.triangles;
+      r.unwritable = out.unwritable;
+      r.dual = out.dual;
+      r.seconds_by_step = remesh::api::JobRecord::StepSeconds{result.phases, result.seconds};
+    });
+    // Cancelled late: its result files go (never served: a job serves results only once it has
+    // succeeded), as a job cancelled sooner has none.
+    if (ended == JobState::Cancelled) store_.remove_results(id);
   } catch (const std::exception& e) {
     {
       std::lock_guard lock(mutex_);
@@ -453,6 +455,11 @@ JobManager::Batch JobManager::poll(const std::string& id, std::size_t cursor, do
   batch.cursor = std::max(cursor, job.events.size());
   batch.ended = remesh::api::is_final(job.record.state);
   return batch;
+}
+
+bool JobManager::stored(const std::string& id) const {
+  std::error_code ec;
+  return std::filesystem::exists(store_.file_path(id, "state.json"), ec);
 }
 
 std::filesystem::path JobManager::file(const std::string& id, const std::string& name) {

@@ -98,6 +98,9 @@ class JobManager {
   /// Path of a stored file of a job, e.g. "remeshed.obj"; for "input.<fmt>", and for a result in a
   /// format its job finished without (added to the service since), the file is made on first use
   /// (the latter from the result's OBJ). Throws std::runtime_error (engine or I/O) while making it.
+  /// Is the job's directory there, whole? (Expiry and the data cap remove it before the job's entry,
+  /// a DELETE after.) False once its removal has begun.
+  bool stored(const std::string& id) const;
   std::filesystem::path file(const std::string& id, const std::string& name);
 
   Gauges gauges() const;

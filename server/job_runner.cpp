@@ -43,6 +43,12 @@ RunOutput run_job(const remesh::api::JobRecord& job, std::string upload, unsigne
   out.result = remesh::equalize(mesh, params, on_iteration, stop);
   if (out.result.outcome == remesh::Outcome::Cancelled) return out;
 
+  // A stop asked for after the run's last check (DELETE, shutdown) cancels the job before its files
+  // are written, as during the run.
+  if (stop.stop_requested()) {
+    out.result.outcome = remesh::Outcome::Cancelled;
+    return out;
+  }
   collect_garbage(mesh);
   // A format that cannot hold the result (STL and GLB store float32: a mesh placed beyond 3.4e38)
   // is not written; a download of it makes it then, and is refused saying why. The job succeeds
@@ -73,6 +79,10 @@ RunOutput run_job(const remesh::api::JobRecord& job, std::string upload, unsigne
       out.result.outcome = remesh::Outcome::Cancelled;
       return out;
     }
+  }
+  if (stop.stop_requested()) {
+    out.result.outcome = remesh::Outcome::Cancelled;
+    return out;
   }
   out.dual = remesh::dual_stats(dual, params.e_min, params.e_max);
   write_each("dual", dual, remesh::api::dual_formats());

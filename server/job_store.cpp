@@ -196,6 +196,14 @@ void JobStore::write_file(const std::string& id, const std::string& name, std::s
   write_file_atomic(dir(id) / name, bytes);
 }
 
+void JobStore::remove_results(const std::string& id) {
+  std::error_code ec;
+  for (const auto& f : fs::directory_iterator(dir(id), ec)) {
+    const std::string name = f.path().filename().string();
+    if (name.starts_with("remeshed.") || name.starts_with("dual.")) fs::remove(f.path(), ec);
+  }
+}
+
 void JobStore::remove(const std::string& id) {
   std::error_code ec;
   fs::remove_all(dir(id), ec);

@@ -57,6 +57,9 @@ class JobStore {
   std::filesystem::path file_path(const std::string& id, const std::string& name) const;
   /// Writes a result file atomically.
   void write_file(const std::string& id, const std::string& name, std::string_view bytes);
+  /// Removes the job's result files (remeshed.*, dual.*), keeping its upload, state and statistics
+  /// (a job cancelled after they were written; no error for files already gone).
+  void remove_results(const std::string& id);
   /// Removes the job's directory (no error if it is gone).
   void remove(const std::string& id);
   /// Bytes used by the job's directory.

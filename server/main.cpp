@@ -49,8 +49,10 @@ int main(int argc, char** argv) {
   sigaddset(&signals, SIGTERM);
   // A hangup (the terminal closed, or a supervisor's reload) stops the service as SIGTERM does; it
   // killed it, and two during one job failed that job as if it had crashed it (JobRecord::attempts).
+  // Not when it was started ignoring hangups (nohup): a blocked signal is waited for even then.
   // The user signals, which it has no use for, are ignored.
-  sigaddset(&signals, SIGHUP);
+  struct sigaction hup {};
+  if (sigaction(SIGHUP, nullptr, &hup) == 0 && hup.sa_handler != SIG_IGN) sigaddset(&signals, SIGHUP);
   pthread_sigmask(SIG_BLOCK, &signals, nullptr);
   ::signal(SIGPIPE, SIG_IGN);
   ::signal(SIGUSR1, SIG_IGN);

@@ -120,7 +120,8 @@ const std::vector<Spec>& specs() {
        }},
       {"max-streams", "N", "concurrent event streams before 503 (default 64)",
        [](Options& o, const std::string& v) {
-         o.max_streams = static_cast<unsigned>(to_size("max-streams", v, kMaxThreads));
+         // At most what leaves the HTTP threads' default, max-streams + 16, within kMaxThreads.
+         o.max_streams = static_cast<unsigned>(to_size("max-streams", v, kMaxThreads - 16));
          // 0 answered every event stream with 503.
          if (o.max_streams == 0) throw std::invalid_argument("--max-streams: at least 1");
        }},

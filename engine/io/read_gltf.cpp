@@ -178,7 +178,8 @@ class Collector {
     AccessorView pv = view_of(model_, pos->second, what + " POSITION", 12);
     const auto& pa = model_.accessors[static_cast<std::size_t>(pos->second)];
     if (pa.type != TINYGLTF_TYPE_VEC3 || pa.componentType != TINYGLTF_COMPONENT_TYPE_FLOAT)
-      fail("glTF: " + what + " POSITION must be VEC3 of FLOAT");
+      fail("glTF: " + what + " POSITION must be VEC3 of FLOAT" +
+           (pa.type == TINYGLTF_TYPE_VEC3 ? " (integer positions, KHR_mesh_quantization, are not read)" : ""));
     const std::size_t first = soup_.points.size();
     // Instancing can multiply geometry: cap what one upload may expand to.
     if (first + pv.count > max_points_)
@@ -357,25 +358,31 @@ RawSoup read_gltf(std::string_view bytes, bool binary, const ReadOptions& option
     fail(std::string(binary ? "GLB" : "glTF") + ": malformed structure the glTF loader could not read (" +
          e.what() + ")");
   }
-  // tinygltf asks for a data: URI it cannot decode as a file.
-  if (guard.first_external.starts_with("data:"))
-    fail("glTF: a data: URI that is not base64 data (" + quote(guard.first_external.substr(0, 40)) +
-         "); only ';base64,' data URIs (or .glb) are read");
-  if (!guard.first_external.empty())
+  // A file tinygltf asked for (every request is refused): when the load failed for it, a buffer
+  // lies outside the upload. An image's (a texture file, or a data: URI of a type it does not
+  // decode, such as webp) only warns: the surface is read without it (a textured file was refused
+  // for its texture). A data: URI tinygltf does not know is asked for as a file.
+  if (!ok && guard.first_external.starts_with("data:"))
+    fail("glTF: a buffer's data: URI that this reader does not decode (" + quote(guard.first_external.substr(0, 40)) +
+         "); it reads base64 data of type application/octet-stream or application/gltf-buffer, or a .glb");
+  if (!ok && !guard.first_external.empty())
     fail("glTF refers to an external file " + quote(guard.first_external) +
          "; only embedded data (data: URIs or .glb) is accepted");
   if (!ok) fail(std::string(binary ? "GLB" : "glTF") + ": " + first_line(err));
 
-  // An extension the file requires changes how its data reads (EXT_meshopt_compression: the buffer
-  // views are compressed): read without it, the positions were garbage. Those about looks only
-  // (materials, textures, lights) leave the geometry as it is.
+  // An extension the file requires that changes where its surface lies: read without it, the
+  // positions were compressed bytes (EXT_meshopt_compression), or one copy of an instanced mesh
+  // stood for all (EXT_mesh_gpu_instancing). Any other is read past: about looks (materials,
+  // textures), or about attributes this reader does not use (KHR_mesh_quantization, which
+  // three.js's exporter requires for 8- and 16-bit normals; quantized positions are refused
+  // below, naming it). Draco is named per primitive below.
   for (const std::string& ext : model.extensionsRequired) {
-    bool looks_only = false;
-    for (const char* prefix : {"KHR_materials_", "KHR_texture_", "KHR_lights_", "EXT_texture_"})
-      looks_only = looks_only || ext.starts_with(prefix);
-    if (!looks_only && ext != "KHR_draco_mesh_compression")  // Draco: named per primitive below
-      fail(std::string(binary ? "GLB" : "glTF") + ": it requires the extension " + quote(ext.substr(0, 64)) +
-           ", which this reader does not support");
+    if (ext == "EXT_meshopt_compression")
+      fail(std::string(binary ? "GLB" : "glTF") + ": its buffers are compressed (EXT_meshopt_compression), which "
+                                                  "this reader does not decode");
+    if (ext == "EXT_mesh_gpu_instancing")
+      fail(std::string(binary ? "GLB" : "glTF") + ": it holds instanced meshes (EXT_mesh_gpu_instancing), which "
+                                                  "this reader does not expand");
   }
   Collector collect(model, options, bytes.size());
   const int scene = model.defaultScene;

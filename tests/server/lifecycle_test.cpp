@@ -7,6 +7,7 @@
 #include <atomic>
 #include <chrono>
 #include <fstream>
+#include <optional>
 #include <thread>
 
 #include "daemon.h"
@@ -99,6 +100,12 @@ TEST_CASE("remeshd: a cancel after the run's last iteration, while its results a
   auto download = c.Get(("/api/v1/jobs/" + id + "/result?mesh=remeshed&format=obj").c_str());
   REQUIRE(download);
   CHECK(download->status == 409);
+  // No result files stay behind it (never served, they counted against the data cap).
+  for (const auto& f : std::filesystem::directory_iterator(tmp.path / "data" / "jobs" / id)) {
+    CAPTURE(f.path().filename().string());
+    CHECK_FALSE(f.path().filename().string().starts_with("remeshed."));
+    CHECK_FALSE(f.path().filename().string().starts_with("dual."));
+  }
 }
 
 TEST_CASE("remeshd: bearer token on /api routes only, CORS", "[server][auth]") {
@@ -416,6 +423,23 @@ TEST_CASE("remeshd: SIGHUP stops the service as SIGTERM does, SIGUSR1 and SIGUSR
   const json done = wait_final(c, id, 90);
   CHECK(done["state"] == "succeeded");
   CHECK(done["attempts"] == 1);  // the run the hangup stopped does not count
+  // Started ignoring hangups (nohup), it keeps ignoring them.
+  struct sigaction ignore {}, before {};
+  ignore.sa_handler = SIG_IGN;
+  REQUIRE(sigaction(SIGHUP, &ignore, &before) == 0);
+  std::optional<Daemon> nohup;
+  try {
+    nohup.emplace(tmp.path / "nohup", std::vector<std::string>{"--workers", "1"});
+  } catch (...) {
+    sigaction(SIGHUP, &before, nullptr);
+    throw;
+  }
+  sigaction(SIGHUP, &before, nullptr);
+  REQUIRE(::kill(nohup->pid(), SIGHUP) == 0);
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  auto still = nohup->client().Get("/healthz");
+  REQUIRE(still);
+  CHECK(still->status == 200);
 }
 
 TEST_CASE("remeshd: SIGTERM waits a short grace for slow clients and not for them to finish", "[server][restart]") {

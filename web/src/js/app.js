@@ -208,8 +208,10 @@ async function submit(e) {
           .join(' ') + ' Choose another file.', { focus: !others.length });
     } else if (err.status === 422) file_error(`The server could not read ${name}: ${err.message}. Fix the file or choose another one.`);
     else if (err.status === 413 && size) {
-      params.show_field_errors([{ field: 'emin', text: `e_min and e_max are so small that the result would have ${size[1]} ` +
-        `${readable(+size[2])} faces, more than this server's limit of ${readable(+size[3])}. Use a larger e_min and e_max.` }],
+      // "over" N: the estimate at its cap (1e18), a bound and no count to show.
+      const faces = size[1] === 'over' ? 'more faces than' : `about ${readable(+size[2])} faces, more than`;
+      params.show_field_errors([{ field: 'emin', text: `e_min and e_max are so small that the result would have ${faces} ` +
+        `this server's limit of ${readable(+size[3])}. Use a larger e_min and e_max.` }],
       { also: ['emax'] });
     } else if (err.status === 413)
       file_error(`${name} is too large for this server: ${readable_numbers(err.message)}. Choose a smaller mesh.`);
