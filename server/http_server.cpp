@@ -205,11 +205,11 @@ bool has_body(const httplib::Request& req) {
   return req.has_header("Content-Length") || req.has_header("Transfer-Encoding");
 }
 
-/// The transfer codings of the request, in order, lower case ("gzip, Chunked" -> gzip, chunked).
-std::vector<std::string> transfer_codings(const httplib::Request& req) {
+/// The items of a list header (Transfer-Encoding, Content-Encoding) over all its lines, in order,
+/// trimmed, lower case, empty ones dropped ("gzip, Chunked" -> gzip, chunked).
+std::vector<std::string> header_list(const httplib::Request& req, const char* name) {
   std::string list;
-  for (std::size_t i = 0; i < req.get_header_value_count("Transfer-Encoding"); ++i)
-    list.append(",").append(req.get_header_value("Transfer-Encoding", i));
+  for (std::size_t i = 0; i < req.get_header_value_count(name); ++i) list.append(",").append(req.get_header_value(name, i));
   std::vector<std::string> codings;
   for (std::size_t begin = 0; begin < list.size();) {
     const std::size_t end = std::min(list.find(',', begin), list.size());
@@ -599,7 +599,7 @@ httplib::Server::HandlerResponse HttpServer::Impl::pre_route(const httplib::Requ
   // after the 30 s read timeout. RFC 9112 6.3: chunked not last is a 400 (the length is unknown);
   // 6.1: a coding before it that the server does not apply (gzip, chunked) is a 501. Both close.
   if (req.has_header("Transfer-Encoding")) {
-    const std::vector<std::string> codings = transfer_codings(req);
+    const std::vector<std::string> codings = header_list(req, "Transfer-Encoding");
     // One field whose whole value is chunked (any case, blanks around it): httplib reads only
     // that as chunked, and read "chunked," (an empty item, dropped from `codings`) to the end.
     std::string only = req.get_header_value("Transfer-Encoding");
@@ -663,20 +663,10 @@ httplib::Server::HandlerResponse HttpServer::Impl::pre_route(const httplib::Requ
   // it (RFC 9110 8.4.1: any case; x-gzip is gzip). Only for a body: a GET saying "UTF-8" there is
   // served as before.
   if (has_body(req) && req.has_header("Content-Encoding")) {
-    std::string list;
-    for (std::size_t i = 0; i < req.get_header_value_count("Content-Encoding"); ++i)
-      list += (i ? "," : "") + req.get_header_value("Content-Encoding", i);
     std::vector<std::string> codings;
-    for (std::size_t begin = 0; begin <= list.size();) {
-      const std::size_t end = std::min(list.find(',', begin), list.size());
-      std::string coding = list.substr(begin, end - begin);
-      begin = end + 1;
-      coding.erase(0, coding.find_first_not_of(" \t"));
-      coding.erase(coding.find_last_not_of(" \t") + 1);
-      for (char& ch : coding) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
-      if (coding == "x-gzip") coding = "gzip";
-      if (!coding.empty() && coding != "identity") codings.push_back(coding);
-    }
+    for (std::string& coding : header_list(req, "Content-Encoding"))
+      if (coding != "identity") codings.push_back(coding == "x-gzip" ? "gzip" : std::move(coding));
+    const std::string list = req.get_header_value("Content-Encoding");
     const bool known = codings.size() == 1 && (codings[0] == "gzip" || codings[0] == "deflate" || codings[0] == "br");
     if (codings.size() > 1 || (codings.size() == 1 && !known)) {
       res.set_header("Connection", "close");  // its body is not read
