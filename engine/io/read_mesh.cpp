@@ -42,8 +42,8 @@ LoadedMesh read_mesh(std::string_view bytes, const ReadOptions& options) {
     // reader's complaint).
     const std::optional<Format> sniffed = options.format ? detect_format(bytes) : std::nullopt;
     if (!sniffed || sniffed == format) throw;
-    throw MeshError(std::string(e.what()) + " (read as " + std::string(format_name(*format)) +
-                    ", the format it was given as; its content looks like " + std::string(format_name(*sniffed)) + ")");
+    throw MeshError(std::string(e.what()) + "; it was read as " + std::string(format_name(*format)) +
+                    " (the format it was given as), but its content looks like " + std::string(format_name(*sniffed)));
   }
   // The OBJ reader passes over lines it does not know: a PLY or OFF file under an .obj name reads
   // as empty. Say what the content looks like instead of "no vertices and no faces".
