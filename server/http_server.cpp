@@ -1148,30 +1148,23 @@ void HttpServer::Impl::result(const httplib::Request& req, httplib::Response& re
     send_problem(res, 500, "cannot make the " + format + " file of this job (the service's log says why)");
     return;
   }
-  // Read once: a job removed meanwhile (DELETE, expiry, the data cap, which remove the files before
-  // the job) takes them at any moment. (Read after a size check, the file could go between: a 500
-  // naming its path.)
-  std::string bytes;
-  try {
-    if (std::filesystem::is_regular_file(path)) bytes = read_file(path);
-  } catch (const std::exception&) {
-    bytes.clear();
-  }
-  // No result is 0 bytes: such a file was damaged in the data directory (it was served as a 200).
-  if (bytes.empty()) {
-    if (removed(rec->id)) {
-      send_problem(res, 404, "the file is gone (the job was removed)");
-      return;
-    }
+  // A file gone or damaged: a job removed meanwhile (DELETE, expiry, the data cap, which remove the
+  // files before the job) takes them at any moment, and then it is a 404; else the data directory
+  // was damaged under the service (no result is 0 bytes: such a file was served as a 200).
+  auto unavailable = [&] {
+    res.headers.erase("ETag");
+    res.headers.erase("Cache-Control");
+    if (removed(rec->id)) return send_problem(res, 404, "the file is gone (the job was removed)");
     std::error_code ec;
     const bool exists = std::filesystem::exists(path, ec);
     log.error("handler", {str("path", req.path), str("job", rec->id),
                           str("error", (exists ? "empty or unreadable " : "missing ") + path.string())});
     send_problem(res, 500, "the job's " + mesh + "." + format + " file is " + (exists ? "empty or unreadable" : "missing") +
                                " in the service's data directory (removed or damaged there)");
-    return;
-  }
-  const std::size_t size = bytes.size();
+  };
+  std::error_code ec;
+  const auto size = std::filesystem::file_size(path, ec);
+  if (ec || size == 0) return unavailable();
   std::string etag = "\"" + rec->id + "-" + mesh + "-" + format + "-" + std::to_string(size) + "\"";
   res.set_header("ETag", etag);
   res.set_header("Cache-Control", "private, no-cache");
@@ -1183,6 +1176,14 @@ void HttpServer::Impl::result(const httplib::Request& req, httplib::Response& re
     res.status = 304;
     return;
   }
+  // Read after the 304 (a revalidation reads no file); the file may go in between (then not a 500
+  // naming its path: the answer above).
+  std::string bytes;
+  try {
+    bytes = read_file(path);
+  } catch (const std::exception&) {
+  }
+  if (bytes.empty()) return unavailable();
   res.set_header("Content-Disposition",
                  remesh::api::content_disposition("attachment", rec->filename, "-" + mesh + "." + format));
   res.set_header("Accept-Ranges", "bytes");

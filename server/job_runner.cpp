@@ -44,11 +44,13 @@ RunOutput run_job(const remesh::api::JobRecord& job, std::string upload, unsigne
   if (out.result.outcome == remesh::Outcome::Cancelled) return out;
 
   // A stop asked for after the run's last check (DELETE, shutdown) cancels the job before its files
-  // are written, as during the run.
-  if (stop.stop_requested()) {
-    out.result.outcome = remesh::Outcome::Cancelled;
-    return out;
-  }
+  // are written (and before the dual's), as during the run.
+  auto stopped = [&] {
+    const bool now = stop.stop_requested();
+    if (now) out.result.outcome = remesh::Outcome::Cancelled;
+    return now;
+  };
+  if (stopped()) return out;
   collect_garbage(mesh);
   // A format that cannot hold the result (STL and GLB store float32: a mesh placed beyond 3.4e38)
   // is not written; a download of it makes it then, and is refused saying why. The job succeeds
@@ -73,17 +75,10 @@ RunOutput run_job(const remesh::api::JobRecord& job, std::string upload, unsigne
   }();
   remesh::PolyMesh dual = remesh::trivalent_dual(mesh, &reference);
   if (params.relax_dual) {
+    // A stop asked for meanwhile ends the relaxation, and is taken below.
     remesh::relax_bonds(dual, params.e_min, params.e_max, reference, params.threads, stop);
-    // A stop asked for meanwhile (DELETE, shutdown) cancels the job, as during the run.
-    if (stop.stop_requested()) {
-      out.result.outcome = remesh::Outcome::Cancelled;
-      return out;
-    }
   }
-  if (stop.stop_requested()) {
-    out.result.outcome = remesh::Outcome::Cancelled;
-    return out;
-  }
+  if (stopped()) return out;
   out.dual = remesh::dual_stats(dual, params.e_min, params.e_max);
   write_each("dual", dual, remesh::api::dual_formats());
   return out;

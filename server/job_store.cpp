@@ -178,16 +178,15 @@ std::vector<remesh::IterationStats> JobStore::load_stats(const std::string& id) 
 }
 
 std::string JobStore::read_upload(const std::string& id) const {
-  // Its message reaches the job's `error` (and a download's answer): the file's name, not the path.
-  std::ifstream in(dir(id) / "upload", std::ios::binary);
-  if (!in) {
-    const int error = errno;
+  // Its message reaches the job's `error` (and a download's answer): the file's name, not the path
+  // read_file's message gives.
+  try {
+    return read_file(dir(id) / "upload");
+  } catch (const std::runtime_error&) {
+    const int error = errno;  // read_file's, unchanged by the throw
     throw std::runtime_error("the job's stored upload cannot be read (" + std::string(std::strerror(error)) +
                              "): its files in the service's data directory were removed or damaged");
   }
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
 }
 
 fs::path JobStore::file_path(const std::string& id, const std::string& name) const { return dir(id) / name; }

@@ -32,6 +32,13 @@ const char* kShort = "emin=0.08&emax=0.12&iterations=5&run_all_iterations=true";
 
 bool running_with_rows(const json& j) { return j["state"] == "running" && j["progress"]["iteration"] >= 1; }
 
+/// A job of ten iterations, submitted and caught running with a row: what a shutdown interrupts.
+std::string running_job(httplib::Client& c) {
+  const std::string id = submit(c, sphere_obj(4), "emin=0.05&emax=0.08&iterations=10&run_all_iterations=true");
+  wait_job(c, id, running_with_rows);
+  return id;
+}
+
 }  // namespace
 
 TEST_CASE("remeshd: cancel queued and running jobs, the queue bound", "[server][cancel]") {
@@ -364,8 +371,7 @@ TEST_CASE("remeshd: SIGTERM interrupts running jobs without losing them, expiry"
   {
     Daemon d(data, {"--workers", "1"});
     auto c = d.client();
-    id = submit(c, sphere_obj(4), "emin=0.05&emax=0.08&iterations=10&run_all_iterations=true");
-    wait_job(c, id, running_with_rows);
+    id = running_job(c);
     // An open event stream does not hold the shutdown up: it ends with a retry hint.
     SseStream stream;
     std::thread reader([&] { stream = read_events(d.port(), "/api/v1/jobs/" + id + "/events", {}, 30); });
@@ -407,8 +413,7 @@ TEST_CASE("remeshd: SIGHUP stops the service as SIGTERM does, SIGUSR1 and SIGUSR
   {
     Daemon d(data, {"--workers", "1"});
     auto c = d.client();
-    id = submit(c, sphere_obj(4), "emin=0.05&emax=0.08&iterations=10&run_all_iterations=true");
-    wait_job(c, id, running_with_rows);
+    id = running_job(c);
     REQUIRE(::kill(d.pid(), SIGUSR1) == 0);
     REQUIRE(::kill(d.pid(), SIGUSR2) == 0);
     std::this_thread::sleep_for(std::chrono::milliseconds(300));
