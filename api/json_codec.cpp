@@ -6,6 +6,8 @@
 #include <functional>
 #include <limits>
 
+#include "dual/dual_stats.h"
+
 namespace remesh {
 
 using nlohmann::json;
@@ -58,6 +60,7 @@ const std::vector<ParamSpec>& param_specs() {
       {"run_all_iterations", Kind::Boolean, false}, {"protect_tips", Kind::Boolean, false},
       {"keep_creases", Kind::Boolean, false},       {"relax_dual", Kind::Boolean, false},
       {"more_regular", Kind::Boolean, false},       {"weld", Kind::Boolean, false},
+      {"bond_min", Kind::Real, false},              {"bond_max", Kind::Real, false},
   };
   return specs;
 }
@@ -83,6 +86,8 @@ void store(ParsedParams& out, std::string_view name, const Value& v) {
   else if (name == "relax_dual") p.relax_dual = v.boolean;
   else if (name == "more_regular") p.more_regular = v.boolean;
   else if (name == "weld") out.weld = v.boolean;
+  else if (name == "bond_min") out.bonds.value().min = v.real;
+  else if (name == "bond_max") out.bonds.value().max = v.real;
 }
 
 const char* kind_message(Kind k) {
@@ -160,13 +165,17 @@ bool parse_text_value(std::string_view s, Kind kind, Value& v) {
   return false;
 }
 
-/// Shared driver: `lookup(name)` returns a parse status for a present key.
+/// Shared driver: `has(name)` says whether a key is present, `parse` reads its value.
+/// The interval is emin and emax, or bond_min and bond_max (ParsedParams::bonds), never both.
 template <class Has, class Parse>
 ParsedParams parse_with(Has has, Parse parse) {
   ParsedParams out;
+  const bool edges = has("emin") || has("emax");
+  if (has("bond_min") || has("bond_max")) out.bonds.emplace();
   for (const ParamSpec& spec : param_specs()) {
     if (!has(spec.name)) {
-      if (spec.required) out.errors.push_back({spec.name, "is required"});
+      // With bonds the edge fields are not required: a missing bond field is (below).
+      if (spec.required && !out.bonds) out.errors.push_back({spec.name, "is required"});
       continue;
     }
     out.given.emplace_back(spec.name);
@@ -174,6 +183,18 @@ ParsedParams parse_with(Has has, Parse parse) {
     if (parse(spec.name, spec.kind, v)) store(out, spec.name, v);
     else out.errors.push_back({spec.name, kind_message(spec.kind)});
   }
+  if (!out.bonds) return out;
+  if (edges) {
+    out.errors.push_back({has("bond_min") ? "bond_min" : "bond_max",
+                          "give either emin and emax (edge lengths) or bond_min and bond_max (the dual's bond "
+                          "lengths), not both"});
+    out.bonds.reset();  // the edge fields stand, checked as given
+    return out;
+  }
+  if (!has("bond_min")) out.errors.push_back({"bond_min", "is required with bond_max"});
+  if (!has("bond_max")) out.errors.push_back({"bond_max", "is required with bond_min"});
+  out.params.e_min = edge_for_bond(out.bonds->min);
+  out.params.e_max = edge_for_bond(out.bonds->max);
   return out;
 }
 

@@ -5,9 +5,11 @@
 ///
 /// Parameter names (API, CLI, JSON): emin, emax, iterations, rings, relax_every, flip_factor,
 /// run_all_iterations, protect_tips, keep_creases, more_regular, relax_dual; `weld` is a read option carried
-/// alongside (ParsedParams::weld).
+/// alongside (ParsedParams::weld); bond_min and bond_max give the interval as the dual's bond lengths
+/// instead of emin and emax (ParsedParams::bonds).
 
 #include <map>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -46,10 +48,21 @@ nlohmann::json summary_json(const MeshSummary& s, const std::vector<Repair>& rep
 
 // ---- parameters ---------------------------------------------------------------------------------
 
+/// An interval given as the trivalent dual's bond lengths (atom lattices: carbon's 1.42 angstrom).
+/// For equilateral triangles of side a the dual edge is a / sqrt(3) (ALGORITHM.md), so bonds in
+/// [min, max] ask for edges in [min, max] * sqrt(3) (edge_for_bond, dual/dual_stats.h).
+struct BondInterval {
+  double min = 0, max = 0;  ///< as given; 0 where missing or unreadable
+};
+
 /// The result of parsing parameters: the values that parsed, and every bad field.
 struct ParsedParams {
   Params params;                   ///< defaults where a field was absent or bad
   bool weld = false;               ///< read option: weld duplicate vertices
+  /// Set when the interval was given as bond_min and bond_max (or one of them) instead of emin and
+  /// emax: params.e_min and e_max then hold the bonds times sqrt(3), and errors about the interval
+  /// name the bond fields (validate_params, check_interval_against).
+  std::optional<BondInterval> bonds;
   std::vector<FieldError> errors;  ///< empty when every field parsed (range checks: check())
   std::vector<std::string> given;  ///< names of the parameters present in the input
   bool ok() const { return errors.empty(); }
@@ -74,6 +87,15 @@ ParsedParams params_from_query(const std::map<std::string, std::string>& values,
 /// `iterations` was not given, the default is lowered to `max_iterations` if above it. Defined in
 /// params_validation.cpp (links the remesher library).
 std::vector<FieldError> validate_params(ParsedParams& parsed, int max_iterations = 0);
+
+/// check_against(mesh, params) (remesh/equalize.h: emin against the mesh's size), its errors said
+/// in bond lengths when the interval was given so (`bonds`): field bond_min, the bound divided by
+/// sqrt(3).
+std::vector<FieldError> check_interval_against(const TriMesh& mesh, const Params& params, bool bonds);
+
+/// Errors about emin and emax said as the bond fields gave them: the fields emin and emax become
+/// bond_min and bond_max, in the field names and in the messages ("must be greater than bond_min").
+std::vector<FieldError> in_bond_terms(std::vector<FieldError> errors);
 
 // ---- statistics as CSV --------------------------------------------------------------------------
 

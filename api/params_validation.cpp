@@ -1,38 +1,80 @@
 #include <algorithm>
+#include <cstdio>
 #include <set>
 
+#include "dual/dual_stats.h"
 #include "json_codec.h"
 
 namespace remesh {
 
+namespace {
+
+/// The bond field an edge field stands for ("emin" -> "bond_min"); other names as they are.
+std::string bond_field(const std::string& field) {
+  if (field == "emin") return "bond_min";
+  if (field == "emax") return "bond_max";
+  return field;
+}
+
+/// `text` with the words emin and emax said as bond_min and bond_max.
+std::string bond_words(std::string text) {
+  for (const auto& [edge, bond] : {std::pair<std::string, std::string>{"emin", "bond_min"}, {"emax", "bond_max"}})
+    for (std::size_t at = text.find(edge); at != std::string::npos; at = text.find(edge, at + bond.size()))
+      text.replace(at, edge.size(), bond);
+  return text;
+}
+
+}  // namespace
+
+std::vector<FieldError> in_bond_terms(std::vector<FieldError> errors) {
+  for (FieldError& e : errors) {
+    e.field = bond_field(e.field);
+    e.message = bond_words(std::move(e.message));
+  }
+  return errors;
+}
+
 std::vector<FieldError> validate_params(ParsedParams& parsed, int max_iterations) {
   std::vector<FieldError> errors = parsed.errors;
+  // The fields already reported, by the engine's names. A bond field's error (unreadable, missing,
+  // given beside emin or emax) is the interval's: no range error about it follows.
   std::set<std::string> bad;
-  for (const FieldError& e : errors) bad.insert(e.field);
+  for (const FieldError& e : errors) {
+    if (e.field == "bond_min" || e.field == "bond_max") bad.insert({"emin", "emax"});
+    bad.insert(e.field);
+  }
   if (max_iterations > 0) {
     parsed.params.max_iterations = max_iterations;
     bool given = std::find(parsed.given.begin(), parsed.given.end(), "iterations") != parsed.given.end();
     if (!given) parsed.params.iterations = std::min(parsed.params.iterations, max_iterations);
   }
-  // Only range-check what parsed; a field already reported is not reported twice.
-  if (!bad.count("emin") && !bad.count("emax")) {
-    for (const FieldError& e : check(parsed.params))
-      if (!bad.count(e.field)) {
-        errors.push_back(e);
-        bad.insert(e.field);
-      }
-  } else {
-    // Fill in a valid stand-in for the bad bound so the other fields still get checked.
-    Params probe = parsed.params;
-    if (bad.count("emin")) probe.e_min = bad.count("emax") ? 1.0 : probe.e_max / 2;
-    if (bad.count("emax")) probe.e_max = bad.count("emin") ? 2.0 : probe.e_min * 2;
-    for (const FieldError& e : check(probe))
-      if (!bad.count(e.field)) {
-        errors.push_back(e);
-        bad.insert(e.field);
-      }
-  }
+  // Only range-check what parsed; a field already reported is not reported twice. A bad bound gets
+  // a valid stand-in so that the other fields still get checked.
+  Params probe = parsed.params;
+  if (bad.count("emin")) probe.e_min = bad.count("emax") ? 1.0 : probe.e_max / 2;
+  if (bad.count("emax")) probe.e_max = bad.count("emin") ? 2.0 : probe.e_min * 2;
+  std::vector<FieldError> range = check(probe);
+  for (const FieldError& e : range)
+    if (!bad.count(e.field)) {
+      bad.insert(e.field);
+      errors.push_back(parsed.bonds ? in_bond_terms({e}).front() : e);
+    }
   return errors;
+}
+
+std::vector<FieldError> check_interval_against(const TriMesh& mesh, const Params& params, bool bonds) {
+  std::vector<FieldError> errors = check_against(mesh, params);
+  if (!bonds) return errors;
+  for (FieldError& e : errors) {
+    if (e.field != "emin") continue;
+    char text[200];
+    std::snprintf(text, sizeof text,
+                  "must be shorter than %.6g, the mesh's bounding-box diagonal / sqrt(3): its edges, bond_min * "
+                  "sqrt(3) or longer, must fit on its surface",
+                  bond_for_edge(bounding_box_diagonal(mesh)));
+    e.message = text;
+  }
+  return in_bond_terms(std::move(errors));
 }
 
 }  // namespace remesh

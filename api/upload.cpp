@@ -145,14 +145,16 @@ PreparedJob prepare_job(std::string_view bytes, std::string_view filename, std::
                      std::to_string(limits.max_faces));
   check_mesh_size(loaded.mesh);
   check_vertex_stars(loaded.mesh);
-  if (auto mesh_errors = check_against(loaded.mesh, params.params); !mesh_errors.empty())
+  if (auto mesh_errors = check_interval_against(loaded.mesh, params.params, params.bonds.has_value());
+      !mesh_errors.empty())
     throw ParamsError(std::move(mesh_errors));
   std::size_t estimate = estimate_output_faces(loaded.mesh, params.params);
   if (params.params.max_output_faces > 0 && estimate > params.params.max_output_faces)
     // An estimate at its cap is a bound, not a count (1e-300 as emax said "about 1000000000000000000").
     throw LimitError("the result would have " + std::string(estimate >= kMaxFaceEstimate ? "over " : "about ") +
                      std::to_string(estimate) + " faces, more than the limit of " +
-                     std::to_string(params.params.max_output_faces) + "; raise emin/emax");
+                     std::to_string(params.params.max_output_faces) +
+                     (params.bonds ? "; raise bond_min/bond_max" : "; raise emin/emax"));
 
   PreparedJob job{JobRecord{}, std::move(loaded)};
   JobRecord& r = job.record;

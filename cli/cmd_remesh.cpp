@@ -14,6 +14,7 @@
 
 #include "args.h"
 #include "commands.h"
+#include "dual/dual_stats.h"
 #include "dual/relax_bonds.h"
 #include "dual/trivalent_dual.h"
 #include "interrupt.h"
@@ -37,8 +38,10 @@ bool ends_with_ignoring_case(const std::string& path, std::string_view ext) {
 bool stats_as_json(const std::string& path) { return ends_with_ignoring_case(path, ".json"); }
 
 const std::vector<OptionSpec> kSpec = {
-    {"emin", "A", "smallest allowed edge length, > 0 (required)"},
-    {"emax", "B", "largest allowed edge length, > A (required)"},
+    {"emin", "A", "smallest allowed edge length, > 0 (required, or --bond-min and --bond-max)"},
+    {"emax", "B", "largest allowed edge length, > A (required, or --bond-min and --bond-max)"},
+    {"bond-min", "A", "instead of --emin/--emax: the dual's shortest bond, > 0 (edges of A*sqrt(3) or longer)"},
+    {"bond-max", "B", "instead of --emin/--emax: the dual's longest bond, > A (edges up to B*sqrt(3))"},
     {"iterations", "N", "iterations n, 1..1000 (default 100)"},
     {"rings", "K", "rings k of the low-pass filter, 1..4 (default 2)"},
     {"relax-every", "PR", "replace the reference surface every PR iterations; 0 = never (default 0)"},
@@ -66,6 +69,7 @@ struct Job {
   std::string in, out;
   std::optional<std::string> dual_out, stats_out;
   Params params;
+  bool bonds = false;  ///< the interval given as the dual's bonds (--bond-min, --bond-max)
   ReadOptions read;
   bool quiet = false;
 };
@@ -77,9 +81,18 @@ Job parse_job(const std::vector<std::string>& args) {
   job.out = a.positional[1];
   // Still reported alone, before the values are read (like parse_args' errors): a run without an
   // interval is refused whatever else is wrong, and the one line names both when both are missing.
-  if (!a.has("emin") || !a.has("emax"))
+  // The interval is --emin and --emax, or the dual's bonds --bond-min and --bond-max.
+  job.bonds = a.has("bond-min") || a.has("bond-max");
+  const char* low = job.bonds ? "bond-min" : "emin";
+  const char* high = job.bonds ? "bond-max" : "emax";
+  if (job.bonds && (a.has("emin") || a.has("emax")))
+    throw UsageError("give either --emin and --emax (edge lengths) or --bond-min and --bond-max (the dual's bond "
+                     "lengths), not both");
+  if (!a.has(low) || !a.has(high))
     throw UsageError(std::string("missing required option") +
-                     (!a.has("emin") && !a.has("emax") ? "s --emin and --emax" : a.has("emin") ? " --emax" : " --emin"));
+                     (!a.has(low) && !a.has(high) ? std::string("s --") + low + " and --" + high
+                                                  : std::string(" --") + (a.has(low) ? high : low)) +
+                     (job.bonds ? "" : " (or --bond-min and --bond-max, the dual's bond lengths)"));
   // Every value is read even after a bad one, so that all bad options are reported at once, with
   // the range errors of the ones that did parse (README: one line per bad option).
   std::vector<FieldError> errors;
@@ -94,8 +107,8 @@ Job parse_job(const std::vector<std::string>& args) {
     }
   };
   Params& p = job.params;
-  if (auto v = read([&] { return a.get_double("emin"); })) p.e_min = *v;
-  if (auto v = read([&] { return a.get_double("emax"); })) p.e_max = *v;
+  if (auto v = read([&] { return a.get_double(low); })) p.e_min = job.bonds ? edge_for_bond(*v) : *v;
+  if (auto v = read([&] { return a.get_double(high); })) p.e_max = job.bonds ? edge_for_bond(*v) : *v;
   if (auto v = read([&] { return a.get_int("iterations", INT_MIN, INT_MAX); })) p.iterations = static_cast<int>(*v);
   if (auto v = read([&] { return a.get_int("rings", INT_MIN, INT_MAX); })) p.rings = static_cast<int>(*v);
   if (auto v = read([&] { return a.get_int("relax-every", INT_MIN, INT_MAX); })) p.relax_every = static_cast<int>(*v);
@@ -115,7 +128,7 @@ Job parse_job(const std::vector<std::string>& args) {
   job.dual_out = a.get("dual");
   job.stats_out = a.get("stats");
 
-  for (auto& e : check(p)) {
+  for (auto& e : job.bonds ? in_bond_terms(check(p)) : check(p)) {
     e.field = option_for(e.field);
     // An option whose value did not parse kept its default, which check() may refuse too (e_min
     // 0): it has its line already.
@@ -235,7 +248,8 @@ int run_remesh(const std::vector<std::string>& args) {
         "Remeshes IN by iterative edge equalization so that its edge lengths lie in [A, B] and writes\n"
         "OUT (.obj .off .ply .stl .glb .xyz .lammps). Shows the statistics every 5 iterations and a\n"
         "final quality summary. Ctrl-C stops after the current step and still writes the (valid) mesh.\n"
-        "For dual edges (bond lengths) in [a, b], ask for the primal interval [a*sqrt(3), b*sqrt(3)].",
+        "For dual edges (bond lengths) in [a, b], give --bond-min a --bond-max b instead: the primal\n"
+        "interval is then [a*sqrt(3), b*sqrt(3)].",
         kSpec);
     return 0;
   }
@@ -248,6 +262,12 @@ int run_remesh(const std::vector<std::string>& args) {
   // A mesh the remesher refuses gets its one line before the repairs are listed.
   check_mesh_size(loaded.mesh);
   check_vertex_stars(loaded.mesh);
+  // Before equalize() checks it in edge lengths: said in the bonds given.
+  if (job.bonds)
+    if (auto errors = check_interval_against(loaded.mesh, job.params, true); !errors.empty()) {
+      for (auto& e : errors) e.field = option_for(e.field);
+      throw ParamsError(std::move(errors));
+    }
   if (!job.quiet) print_repairs(std::cerr, loaded.repairs);
   std::optional<ReferenceSurface> reference;
   if (job.dual_out) reference.emplace(loaded.mesh);

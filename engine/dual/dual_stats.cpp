@@ -12,7 +12,7 @@ DualStats dual_stats(const PolyMesh& dual, double e_min, double e_max) {
   for (auto f : dual.faces())
     if (!dual.status(f).deleted()) ++s.rings[dual.valence(f)];
   const bool interval = e_min > 0 && e_max > e_min;
-  if (interval) s.bond_min = e_min / std::sqrt(3.0), s.bond_max = e_max / std::sqrt(3.0);
+  if (interval) s.bond_min = bond_for_edge(e_min), s.bond_max = bond_for_edge(e_max);
   double sum = 0;
   s.min = std::numeric_limits<double>::infinity();
   for (auto e : dual.edges()) {

@@ -7,12 +7,19 @@
 /// For equilateral triangles of side a the dual edge is a / sqrt(3) (ALGORITHM.md), so the bonds
 /// of a primal run in [e_min, e_max] are judged against [e_min, e_max] / sqrt(3).
 
+#include <cmath>
 #include <cstddef>
 #include <map>
 
 #include "core/mesh.h"
 
 namespace remesh {
+
+/// The primal edge length whose equilateral triangles have dual edges (bonds) of length `bond`:
+/// bond * sqrt(3). A bond interval [b_min, b_max] asks for edges in [b_min, b_max] * sqrt(3).
+inline double edge_for_bond(double bond) { return bond * std::sqrt(3.0); }
+/// The dual edge (bond) of equilateral triangles of side `edge`: edge / sqrt(3).
+inline double bond_for_edge(double edge) { return edge / std::sqrt(3.0); }
 
 struct DualStats {
   std::size_t atoms = 0;  ///< dual vertices

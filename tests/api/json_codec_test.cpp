@@ -2,6 +2,8 @@
 #include <catch2/catch.hpp>
 
 #include <algorithm>
+#include <cmath>
+#include <map>
 #include <set>
 #include <sstream>
 
@@ -117,6 +119,58 @@ TEST_CASE("params_from_query: strings parse strictly", "[api][params]") {
     INFO(what.str());
     CHECK(fields_of(params_from_query(row.values).errors) == row.fields);
   }
+}
+
+TEST_CASE("bond_min and bond_max give the interval as the dual's bonds", "[api][params]") {
+  // Bonds b ask for edges b * sqrt(3) (equilateral triangles of side a have dual edges a / sqrt(3)).
+  for (const auto& [lo, hi] : {std::pair{1.278, 1.562}, std::pair{0.05, 0.06}, std::pair{2.0, 3.0}}) {
+    INFO(lo << " " << hi);
+    ParsedParams j = params_from_json(json{{"bond_min", lo}, {"bond_max", hi}, {"iterations", 9}});
+    REQUIRE(j.ok());
+    REQUIRE(j.bonds);
+    CHECK(j.bonds->min == lo);
+    CHECK(j.bonds->max == hi);
+    CHECK(j.params.e_min == Approx(lo * std::sqrt(3.0)).epsilon(1e-15));
+    CHECK(j.params.e_max == Approx(hi * std::sqrt(3.0)).epsilon(1e-15));
+    CHECK(j.params.iterations == 9);
+    CHECK(validate_params(j).empty());
+    using Map = std::map<std::string, std::string>;
+    ParsedParams q = params_from_query(Map{{"bond_min", std::to_string(lo)}, {"bond_max", std::to_string(hi)}});
+    REQUIRE(q.ok());
+    CHECK(q.params.e_min == Approx(lo * std::sqrt(3.0)));
+  }
+  CHECK_FALSE(params_from_json(json{{"emin", 1}, {"emax", 2}}).bonds);
+
+  // Each mistake names the fields the client gave, never an edge field it did not.
+  struct Row {
+    json doc;
+    std::set<std::string> fields;
+    const char* says;  // in the first error's message
+  };
+  const Row rows[] = {
+      {{{"bond_min", 1}}, {"bond_max"}, "is required with bond_min"},
+      {{{"bond_max", 1}}, {"bond_min"}, "is required with bond_max"},
+      {{{"bond_min", 1}, {"bond_max", 2}, {"emin", 1}}, {"bond_min"}, "not both"},
+      {{{"bond_max", 2}, {"emax", 3}, {"emin", 1}}, {"bond_max"}, "not both"},
+      {{{"bond_min", 2}, {"bond_max", 1}}, {"bond_max"}, "must be greater than bond_min"},
+      {{{"bond_min", -1}, {"bond_max", 1}}, {"bond_min"}, "> 0"},
+      {{{"bond_min", "x"}, {"bond_max", 1}}, {"bond_min"}, "finite number"},
+      {{{"bond_min", "x"}, {"rings", 9}}, {"bond_min", "bond_max", "rings"}, "finite number"},
+      {{{"bond_min", 1}, {"bond_max", 2}, {"rings", 0}}, {"rings"}, "1..4"},
+  };
+  for (const Row& row : rows) {
+    INFO(row.doc.dump());
+    ParsedParams p = params_from_json(row.doc);
+    const std::vector<FieldError> errors = validate_params(p);
+    CHECK(fields_of(errors) == row.fields);
+    REQUIRE_FALSE(errors.empty());
+    CHECK_THAT(errors.front().message, Catch::Contains(row.says));
+  }
+  // Edge errors said in bond terms: fields and words.
+  const auto said = in_bond_terms({{"emax", "must be greater than emin"}, {"rings", "must be in 1..4"}});
+  CHECK(said[0].field == "bond_max");
+  CHECK(said[0].message == "must be greater than bond_min");
+  CHECK(said[1].field == "rings");
 }
 
 TEST_CASE("Params and summaries map to the documented JSON names", "[api][json]") {

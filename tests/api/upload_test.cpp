@@ -1,6 +1,7 @@
 // Uploads turned into jobs: format resolution, parameter and mesh errors, limits.
 #include <catch2/catch.hpp>
 
+#include <cmath>
 #include <set>
 
 #include "api/upload.h"
@@ -128,6 +129,25 @@ TEST_CASE("prepare_job: the errors it must give", "[api][upload]") {
       CHECK(std::string(e.errors().front().message).find("bounding-box diagonal") != std::string::npos);
     }
     CHECK_NOTHROW(prepare_job(obj, "x.obj", Format::Obj, params({{"emin", 0.2}, {"emax", 1e300}}), {}));
+  }
+  SECTION("a bond_min whose edges no part of the mesh can hold, said in bonds") {
+    // bond_min 2.5 asks for edges of 4.33, past the diagonal of about 3.5; the bound is 3.5 / sqrt(3).
+    try {
+      prepare_job(obj, "x.obj", Format::Obj, params({{"bond_min", 2.5}, {"bond_max", 3}}), {});
+      FAIL("no ParamsError");
+    } catch (const ParamsError& e) {
+      CHECK(fields_of(e) == std::set<std::string>{"bond_min"});
+      const std::string message = e.errors().front().message;
+      CHECK_THAT(message, Catch::Contains("diagonal / sqrt(3)"));
+      CHECK_THAT(message, !Catch::Contains("emin"));
+    }
+    const PreparedJob ok = prepare_job(obj, "x.obj", Format::Obj, params({{"bond_min", 0.12}, {"bond_max", 0.2}}), {});
+    CHECK(ok.record.params.e_min == Approx(0.12 * std::sqrt(3.0)));
+    CHECK(ok.record.params.e_max == Approx(0.2 * std::sqrt(3.0)));
+    UploadLimits out;
+    out.max_output_faces = 100;
+    CHECK_THROWS_WITH(prepare_job(obj, "x.obj", Format::Obj, params({{"bond_min", 0.001}, {"bond_max", 0.002}}), out),
+                      Catch::Contains("raise bond_min/bond_max"));
   }
   SECTION("iterations over the service limit") {
     UploadLimits limits;

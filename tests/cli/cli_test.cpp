@@ -5,8 +5,10 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <cstdio>
 #include <cstdlib>
 #include <fstream>
+#include <iterator>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
@@ -158,6 +160,13 @@ TEST_CASE("bad arguments exit with 2 and one line on stderr", "[cli]") {
                    "option '--dual' needs a value (DUAL_OUT), but is followed by '--stats'"});
   cases.push_back({{mesh, out, "--emin", "--emax", "0.3"}, "option '--emin' needs a value"});
   cases.push_back({{mesh, out, "--emin", "0.2", "--emax", "0.3", "--dual", "--relax-dual"}, "followed by '--relax-dual'"});
+  // The interval as the dual's bonds: each mistake named by the options given.
+  cases.push_back({{mesh, out, "--bond-min", "0.1"}, "missing required option --bond-max"});
+  cases.push_back({{mesh, out, "--bond-min", "0.1", "--bond-max", "0.2", "--emin", "0.2"}, "not both"});
+  cases.push_back({{mesh, out, "--bond-min", "0.2", "--bond-max", "0.1"}, "--bond-max: must be greater than bond_min"});
+  cases.push_back({{mesh, out, "--bond-min", "x", "--bond-max", "0.1"}, "--bond-min: 'x' is not a number"});
+  // The icosphere's bounding-box diagonal is 2 sqrt(3): edges of at least 2 * sqrt(3) (bonds of 2) cannot fit.
+  cases.push_back({{mesh, out, "--bond-min", "2.5", "--bond-max", "3"}, "--bond-min: must be shorter than 2,"});
   // A name longer than the file system takes (a long one it takes is written: the probe was
   // named after it, and too long itself).
   cases.push_back({{"convert", mesh, dir.file(std::string(300, 'a') + ".obj")}, "output file name too long"});
@@ -448,6 +457,30 @@ TEST_CASE("remesh --relax-dual puts more of the dual's bonds inside the bond int
   CHECK(alone.exit_code == 2);
   CHECK(alone.err.find("--relax-dual") != std::string::npos);
   CHECK(std::count(alone.err.begin(), alone.err.end(), '\n') == 1);
+}
+
+TEST_CASE("an interval of bonds, --bond-min and --bond-max, runs as --emin and --emax times sqrt(3)", "[cli]") {
+  TempDir dir;
+  write_obj(remesh::test::make_icosphere(3), dir.file("sphere.obj"));
+  char edge_min[32], edge_max[32];
+  std::snprintf(edge_min, sizeof edge_min, "%.17g", 0.08 * std::sqrt(3.0));
+  std::snprintf(edge_max, sizeof edge_max, "%.17g", 0.1 * std::sqrt(3.0));
+  const ProcessResult by_edges = remesh_cli({dir.file("sphere.obj"), dir.file("e.obj"), "--emin", edge_min, "--emax",
+                                             edge_max, "--dual", dir.file("e_dual.obj"), "--iterations", "8"});
+  const ProcessResult by_bonds = remesh_cli({dir.file("sphere.obj"), dir.file("b.obj"), "--bond-min", "0.08",
+                                             "--bond-max", "0.1", "--dual", dir.file("b_dual.obj"), "--iterations", "8"});
+  INFO(by_edges.err << by_bonds.err);
+  REQUIRE(by_edges.exit_code == 0);
+  REQUIRE(by_bonds.exit_code == 0);
+  auto bytes = [](const std::string& path) {
+    std::ifstream f(path, std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(f), {});
+  };
+  CHECK(bytes(dir.file("b.obj")) == bytes(dir.file("e.obj")));
+  CHECK(bytes(dir.file("b_dual.obj")) == bytes(dir.file("e_dual.obj")));
+  CHECK_FALSE(bytes(dir.file("b.obj")).empty());
+  // The summary judges the bonds against the interval given.
+  CHECK(by_bonds.out.find("bonds inside [0.08, 0.1] = [e_min, e_max] / sqrt(3)") != std::string::npos);
 }
 
 TEST_CASE("the summary says how many edges outside lie in parts too thin for the interval", "[cli]") {

@@ -326,6 +326,41 @@ TEST_CASE("remeshd: relax_dual relaxes the dual's bonds, and its downloads are t
   CHECK(error_fields(bad) == std::set<std::string>{"relax_dual"});
 }
 
+TEST_CASE("remeshd: bond_min and bond_max ask for the dual's bonds, edges sqrt(3) times as long", "[server]") {
+  TempDir tmp;
+  Daemon d(tmp.path / "data", {"--workers", "1"});
+  auto c = d.client();
+  const std::string mesh = sphere_obj(2);
+  auto r = submit_raw(c, mesh, "bond_min=0.12&bond_max=0.18&iterations=4&filename=ball.obj");
+  REQUIRE(r);
+  REQUIRE(r->status == 202);
+  const json params = body_of(r)["params"];
+  CHECK(params["emin"].get<double>() == Approx(0.12 * std::sqrt(3.0)));
+  CHECK(params["emax"].get<double>() == Approx(0.18 * std::sqrt(3.0)));
+  const json done = wait_final(c, body_of(r)["id"]);
+  REQUIRE(done["state"] == "succeeded");
+  CHECK(done["dual"]["bond_interval"][0].get<double>() == Approx(0.12));
+  CHECK(done["dual"]["bond_interval"][1].get<double>() == Approx(0.18));
+  // Multipart params too; each mistake is a 422 naming the bond fields given.
+  httplib::MultipartFormDataItems items = {{"mesh", mesh, "ball.obj", "text/plain"},
+                                           {"params", R"({"bond_min":0.12,"bond_max":0.18})", "", "application/json"}};
+  auto multipart = c.Post("/api/v1/jobs", items);
+  REQUIRE(multipart);
+  CHECK(multipart->status == 202);
+  for (const auto& [query, field] : {std::pair<std::string, std::string>{"bond_min=0.1&bond_max=0.2&emin=0.2", "bond_min"},
+                                     {"bond_min=0.1", "bond_max"},
+                                     {"bond_min=0.3&bond_max=0.2", "bond_max"},
+                                     {"bond_min=5&bond_max=6", "bond_min"}}) {
+    INFO(query);
+    auto bad = submit_raw(c, mesh, query);
+    REQUIRE(bad);
+    CHECK(bad->status == 422);
+    CHECK(error_fields(bad) == std::set<std::string>{field});
+    // Said in the bonds given (but where the message is that edges and bonds were both given).
+    if (query.find("emin") == std::string::npos) CHECK(bad->body.find("emin") == std::string::npos);
+  }
+}
+
 TEST_CASE("remeshd: the errors each route must give", "[server]") {
   TempDir tmp;
   Daemon d(tmp.path / "data", {"--workers", "1", "--max-iterations", "50", "--max-faces", "2000",
@@ -463,6 +498,8 @@ TEST_CASE("remeshd: api/openapi.yaml documents every job parameter the codec rea
   nlohmann::json echoed = remesh::Params{};
   echoed["weld"] = false;
   REQUIRE(echoed.size() >= 9);
+  for (const std::string& name : remesh::param_names()) echoed[name] = nullptr;  // bond_min, bond_max
+  CHECK(echoed.contains("bond_min"));
   for (const auto& [name, value] : echoed.items()) {
     INFO(name);
     CHECK(yaml.find("- {name: " + name + ", in: query") != std::string::npos);

@@ -80,6 +80,20 @@ async function main() {
   await page.fill('#tolerance', '20');
   check(await page.textContent('#helper-error') === '', 'editing ± % clears its message');
 
+  // --- a target bond of the dual: edges √3 times as long, the bond interval shown ---
+  const edge_target = +(await page.inputValue('#target'));
+  await page.selectOption('#target-of', 'bond');
+  const as_bond = { emin: +(await page.inputValue('#emin')), emax: +(await page.inputValue('#emax')) };
+  const bonds_shown = await page.textContent('#bond-interval');
+  const bond_lo = +(0.8 * edge_target).toPrecision(4), bond_hi = +(1.2 * edge_target).toPrecision(4);
+  check(Math.abs(as_bond.emin - 0.8 * Math.sqrt(3) * edge_target) < 1e-3 * as_bond.emin &&
+    Math.abs(as_bond.emax - 1.2 * Math.sqrt(3) * edge_target) < 1e-3 * as_bond.emax &&
+    bonds_shown === `[${bond_lo}, ${bond_hi}]`,
+    `a target bond b fills e_min/e_max = b √3 ±20 % and shows the bonds (b ${edge_target}: ${as_bond.emin}..${as_bond.emax}, "${bonds_shown}")`);
+  await page.selectOption('#target-of', 'edge');
+  check(+(await page.inputValue('#emin')) === filled.emin && +(await page.inputValue('#emax')) === filled.emax,
+    'back to a target edge, the interval is the edge one again');
+
   // --- a decimal comma typed into a number field is a point (Chromium read "0,5" as 5) ---
   const target_before = await page.inputValue('#target');
   await page.fill('#target', '');

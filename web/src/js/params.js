@@ -28,6 +28,7 @@ export function write_params(params) {
   if (!params) return;
   for (const name of NUMBERS) if (params[name] !== undefined) $(name).value = params[name];
   for (const name of BOOLEANS) if (params[name] !== undefined) $(name).checked = !!params[name];
+  show_bonds();
   // A job that used any of the folded options shows them.
   if (FOLDED.some((name) => $(name).type === 'checkbox' ? $(name).checked : $(name).value !== $(name).defaultValue))
     $('more-options').open = true;
@@ -134,8 +135,20 @@ function decimal_comma() {
   }
 }
 
+/// Edge length per unit of target: 1 for a target edge, √3 for a target bond of the dual
+/// (equilateral triangles of side a have dual edges a / √3; the API's bond_min/bond_max do the same).
+const per_target = () => ($('target-of').value === 'bond' ? Math.sqrt(3) : 1);
+
+/// The dual's bond interval [e_min, e_max] / √3 beside the helper, from the form as typed.
+export function show_bonds() {
+  const { emin, emax } = interval();
+  $('bond-interval').textContent = emin > 0 && emax > emin
+    ? `[${round(emin / Math.sqrt(3))}, ${round(emax / Math.sqrt(3))}]` : '–';
+}
+
 /// The helper: target mean ± tolerance % -> emin/emax. `on_change` runs after the form changed.
 /// A wrong target or tolerance is named beside the helper instead of being replaced by a default.
+/// The target is an edge length or, with "dual bond" chosen, a bond length of the dual.
 export function init_helper(on_change) {
   clear_on_edit();
   decimal_comma();
@@ -152,7 +165,7 @@ export function init_helper(on_change) {
     const percent = $('tolerance').valueAsNumber;
     if (!(target > 0)) {
       complain('target', $('target').value === '' && !$('target').validity.badInput
-        ? 'Target mean is empty: enter the edge length wanted (or press "use it" for the input\'s mean).'
+        ? `Target mean is empty: enter the ${per_target() > 1 ? "dual's bond" : 'edge'} length wanted (or press "use it" for the input's mean).`
         : 'Target mean must be a number greater than 0.');
       return;
     }
@@ -162,9 +175,10 @@ export function init_helper(on_change) {
     }
     complain('', '');
     const tol = percent / 100;
-    $('emin').value = round(target * (1 - tol));
-    $('emax').value = round(target * (1 + tol));
+    $('emin').value = round(target * per_target() * (1 - tol));
+    $('emax').value = round(target * per_target() * (1 + tol));
     clear_field_errors(['emin', 'emax']);
+    show_bonds();
     on_change();
   };
   $('apply-target').addEventListener('click', apply);
@@ -176,9 +190,11 @@ export function init_helper(on_change) {
   }
   $('use-mean').addEventListener('click', () => {
     const mean = +$('input-mean').dataset.value;
-    if (mean > 0) { $('target').value = round(mean); apply(); }
+    if (mean > 0) { $('target').value = round(mean / per_target()); apply(); }
   });
-  for (const id of ['emin', 'emax']) $(id).addEventListener('input', on_change);
+  // A target typed already is taken as the new kind of length.
+  $('target-of').addEventListener('change', () => { if ($('target').valueAsNumber > 0) apply(); });
+  for (const id of ['emin', 'emax']) $(id).addEventListener('input', () => { show_bonds(); on_change(); });
   return apply;
 }
 
@@ -197,9 +213,9 @@ export function set_input_mean(mean, source, { fill = false, target = false, cle
     $('target').value = '';
     $('helper-error').textContent = '';
   }
-  if (mean > 0 && target) $('target').value = round(mean);
+  if (mean > 0 && target) $('target').value = round(mean / per_target());
   else if (mean > 0 && (fill || $('target').value === '')) {
-    $('target').value = round(mean);
+    $('target').value = round(mean / per_target());
     $('apply-target').click();
   }
 }
