@@ -22,6 +22,7 @@
 #include "routes.h"
 #include "sse.h"
 #include "static_files.h"
+#include "upload_gate.h"
 
 namespace remeshd {
 
@@ -63,6 +64,9 @@ constexpr const char* kPrefix = "/api/v1";
 constexpr std::size_t kMiB = 1024 * 1024;
 /// Uploads from this size on have the memory they took handed back to the system after their answer.
 constexpr std::size_t kTrimAfterBytes = 8 * kMiB;
+/// An upload of this size or more (or of unknown length: chunked) waits for a slot of the upload
+/// gate (upload_gate.h) before it is read; smaller ones, at most about 40 MB each read, go at once.
+constexpr std::size_t kGatedUploadBytes = 4 * kMiB;
 constexpr std::size_t kMaxParamsBytes = 64 * 1024;
 /// The query keys of POST /jobs that are not job parameters.
 const std::vector<std::string> kUploadQueryKeys = {"format", "filename", "access_token"};
@@ -318,6 +322,7 @@ struct HttpServer::Impl {
   std::mutex served_mutex;
   std::condition_variable served_changed;
   bool served = false;  ///< serve() has returned
+  std::unique_ptr<UploadGate> upload_gate;  ///< made by setup()
 
   Impl(const Options& o, JobManager& j, Metrics& m, Logger& l, std::filesystem::path root)
       : options(o), jobs(j), metrics(m), log(l), web_root(std::move(root)) {}
@@ -422,6 +427,10 @@ bool HttpServer::Impl::authorized(const httplib::Request& req) const {
 void HttpServer::Impl::setup() {
   unsigned threads = options.http_threads ? options.http_threads : options.max_streams + 16;
   server.new_task_queue = [threads] { return new httplib::ThreadPool(threads); };
+  // At most a quarter of the HTTP threads wait at the gate, so that the rest still answer (the
+  // page's polls, downloads, health checks).
+  const unsigned slots = options.upload_slots ? options.upload_slots : static_cast<unsigned>(jobs.gauges().workers);
+  upload_gate = std::make_unique<UploadGate>(slots, options.upload_wait_seconds, std::max(1u, threads / 4));
   server.set_payload_max_length(options.max_upload_mb * kMiB + kMiB);  // Content-Length; chunked counted below
   // httplib's default also sets SO_REUSEPORT, which lets a second daemon bind the same port.
   server.set_socket_options([](socket_t sock) {
@@ -770,7 +779,10 @@ void HttpServer::Impl::health(const httplib::Request&, httplib::Response& res) {
              {"busy_workers", g.busy_workers},
              {"queue_depth", g.queue_depth},
              {"jobs", total},
-             {"event_streams", streams.load()}});
+             {"event_streams", streams.load()},
+             // Large uploads being read and checked, and waiting for a slot (upload_gate.h).
+             {"uploads", {{"reading", upload_gate->busy()}, {"waiting", upload_gate->waiting()},
+                          {"slots", upload_gate->slots()}}}});
 }
 
 bool HttpServer::Impl::removed(const std::string& id) const {
@@ -827,6 +839,33 @@ void HttpServer::Impl::post_job(const httplib::Request& req, httplib::Response& 
       res.set_header("Connection", "close");
       return;
     }
+  }
+  // A large upload is read, and its mesh checked, while it holds a slot of the gate (upload_gate.h:
+  // reading a mesh takes about ten times its size for a moment); the answer waits for one.
+  std::optional<UploadGate::Pass> pass;
+  const bool large = req.has_header("Content-Length")
+                         ? std::stoull(req.get_header_value("Content-Length")) >= kGatedUploadBytes
+                         : has_body(req);
+  if (large) {
+    UploadGate::Entry entry = upload_gate->enter();
+    if (!entry.pass) {
+      // The body is read and dropped, up to kDrainBytes, so that a client that sends before it
+      // reads gets the answer rather than a reset (as for a 413).
+      std::size_t drained = 0;
+      auto discard = [&drained](const char*, std::size_t n) { return (drained += n) <= kDrainBytes; };
+      if (req.is_multipart_form_data()) reader([](const httplib::MultipartFormData&) { return true; }, discard);
+      else reader(discard);
+      const bool closed = entry.refusal == UploadGate::Refusal::Closed;
+      res.set_header("Retry-After", closed ? "5" : "10");
+      res.set_header("Connection", "close");
+      send_problem(res, 503,
+                   closed ? std::string("the server is shutting down")
+                          : "the server is reading " + std::to_string(upload_gate->slots()) +
+                                " other large uploads and no slot came free (--upload-slots, --upload-wait-seconds); "
+                                "try again in a few seconds");
+      return;
+    }
+    pass = std::move(entry.pass);
   }
   // No body ('curl -X POST' without a file got its error after 30 s): nothing to read, and the
   // checks below say what is missing.
@@ -1261,6 +1300,7 @@ bool HttpServer::serve() {
 
 bool HttpServer::stop(double grace_seconds) {
   impl_->jobs.wake_all();
+  if (impl_->upload_gate) impl_->upload_gate->close();
   impl_->server.stop();
   std::unique_lock lock(impl_->served_mutex);
   return impl_->served_changed.wait_for(lock, std::chrono::duration<double>(grace_seconds),

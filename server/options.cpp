@@ -125,6 +125,17 @@ const std::vector<Spec>& specs() {
          // 0 answered every event stream with 503.
          if (o.max_streams == 0) throw std::invalid_argument("--max-streams: at least 1");
        }},
+      {"upload-slots", "N",
+       "uploads of 4 MiB or more (or of unknown length) read and checked at once; more wait (default: as many as workers)",
+       [](Options& o, const std::string& v) {
+         o.upload_slots = static_cast<unsigned>(to_size("upload-slots", v, kMaxThreads));
+       }},
+      {"upload-wait-seconds", "S", "how long a large upload waits for a slot before a 503 (default 60)",
+       [](Options& o, const std::string& v) {
+         o.upload_wait_seconds = to_double("upload-wait-seconds", v);
+         if (!(o.upload_wait_seconds >= 0 && o.upload_wait_seconds <= 3600))
+           throw std::invalid_argument("--upload-wait-seconds: 0 to 3600");
+       }},
       {"stream-lifetime-seconds", "S", "an event stream ends after S seconds; clients reconnect (default 300)",
        [](Options& o, const std::string& v) {
          o.stream_lifetime_seconds = to_double("stream-lifetime-seconds", v);

@@ -28,6 +28,8 @@ struct Options {
   std::string web_root;               ///< "" = built-in default (see server/README.md)
   unsigned http_threads = 0;          ///< HTTP thread pool; 0 = max_streams + 16
   unsigned max_streams = 64;          ///< concurrent SSE streams before 503
+  unsigned upload_slots = 0;          ///< large uploads read at once (upload_gate.h); 0 = as many as workers
+  double upload_wait_seconds = 60;    ///< a large upload waits this long for a slot, then 503
   double stream_lifetime_seconds = 300;  ///< an SSE stream ends after this with a retry: hint
   double heartbeat_seconds = 15;      ///< `: ping` comment interval on idle streams
 };

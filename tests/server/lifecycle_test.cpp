@@ -221,6 +221,51 @@ TEST_CASE("remeshd: upload limits are enforced while reading", "[server][limits]
   CHECK(ok->status == 202);
 }
 
+TEST_CASE("remeshd: large uploads are read a few at a time, one that waits too long gets a 503", "[server][limits]") {
+  // Reading a mesh takes about ten times its size in memory: large uploads take a slot each
+  // (--upload-slots), and wait for one up to --upload-wait-seconds.
+  TempDir tmp;
+  Daemon d(tmp.path / "data", {"--workers", "1", "--upload-slots", "1", "--upload-wait-seconds", "1"});
+  auto c = d.client();
+  auto uploads = [&c] {
+    auto h = c.Get("/healthz");
+    REQUIRE(h);
+    return json::parse(h->body)["uploads"];
+  };
+  CHECK(uploads() == json{{"reading", 0}, {"waiting", 0}, {"slots", 1}});
+  // A 5 MiB upload trickling in holds the one slot.
+  std::atomic<bool> stop{false};
+  std::thread holder = slow_client(d.port(),
+                                   "POST /api/v1/jobs?emin=0.2&emax=0.35 HTTP/1.1\r\nHost: x\r\nContent-Type: "
+                                   "model/obj\r\nContent-Length: 5242880\r\n\r\n",
+                                   "# a comment line\n", 0.05, stop);
+  for (int i = 0; i < 200 && uploads()["reading"] != 1; ++i) std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  REQUIRE(uploads()["reading"] == 1);
+  // Another large one waits about the second it may, and gets a 503 it can read, with Retry-After.
+  std::string large = sphere_obj(2);
+  while (large.size() < 5 * 1024 * 1024) large += "# padding comment line to make the upload a large one\n";
+  const auto start = std::chrono::steady_clock::now();
+  auto refused = submit_raw(c, large, "emin=0.2&emax=0.35&iterations=2");
+  const double waited = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  REQUIRE(refused);
+  CHECK(refused->status == 503);
+  CHECK(refused->get_header_value("Retry-After") == "10");
+  CHECK(refused->body.find("--upload-slots") != std::string::npos);
+  CHECK(waited >= 0.9);
+  // A small upload does not wait at the gate.
+  auto small = submit_raw(c, sphere_obj(2), "emin=0.2&emax=0.35&iterations=2");
+  REQUIRE(small);
+  CHECK(small->status == 202);
+  // The slot freed, the large upload is read and becomes a job.
+  stop = true;
+  holder.join();
+  for (int i = 0; i < 200 && uploads()["reading"] != 0; ++i) std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  auto accepted = submit_raw(c, large, "emin=0.2&emax=0.35&iterations=2");
+  REQUIRE(accepted);
+  CHECK(accepted->status == 202);
+  CHECK(uploads() == json{{"reading", 0}, {"waiting", 0}, {"slots", 1}});
+}
+
 TEST_CASE("remeshd: static files from the web root, safely", "[server][static]") {
   TempDir tmp;
   TempDir web;

@@ -1,7 +1,11 @@
 // Pieces of remeshd that need no process: options, static paths, SSE frames, storage.
 #include <catch2/catch.hpp>
 
+#include <chrono>
 #include <cstdlib>
+#include <future>
+#include <optional>
+#include <thread>
 #include <fstream>
 #include <map>
 #include <random>
@@ -16,6 +20,7 @@
 #include "routes.h"
 #include "sse.h"
 #include "static_files.h"
+#include "upload_gate.h"
 #include "support/mesh_generators.h"
 
 using namespace remeshd;
@@ -262,4 +267,44 @@ TEST_CASE("run_job hands each result file to the sink once, and none when cancel
                                       [&](const std::string&, std::string_view) { ++calls; });
   CHECK(cancelled.result.outcome == remesh::Outcome::Cancelled);
   CHECK(calls == 0);
+}
+
+TEST_CASE("UploadGate: slots, a bounded wait, a bounded line, and close", "[server][uploads]") {
+  using Clock = std::chrono::steady_clock;
+  UploadGate gate(1, 0.3, 1);
+  UploadGate::Entry first = gate.enter();
+  REQUIRE(first.pass);
+  CHECK(gate.busy() == 1);
+  // The one slot taken: the next waits the whole wait, then is refused as busy.
+  const auto start = Clock::now();
+  UploadGate::Entry late = gate.enter();
+  CHECK_FALSE(late.pass);
+  CHECK(late.refusal == UploadGate::Refusal::Busy);
+  CHECK(std::chrono::duration<double>(Clock::now() - start).count() >= 0.25);
+  // One waiting already (the line holds one): another is refused at once.
+  auto waiter = std::async(std::launch::async, [&] { return gate.enter().pass.has_value(); });
+  while (gate.waiting() == 0) std::this_thread::yield();
+  const auto at = Clock::now();
+  CHECK_FALSE(gate.enter().pass);
+  CHECK(std::chrono::duration<double>(Clock::now() - at).count() < 0.2);
+  // The slot freed: the waiter gets it.
+  first.pass.reset();
+  CHECK(waiter.get());
+  CHECK(gate.busy() == 0);  // its pass was dropped with the task's entry
+  // Closed: a waiter is woken, and every later entry refused, as closed.
+  UploadGate::Entry held = gate.enter();
+  REQUIRE(held.pass);
+  auto woken = std::async(std::launch::async, [&] { return gate.enter().refusal; });
+  while (gate.waiting() == 0) std::this_thread::yield();
+  gate.close();
+  CHECK(woken.get() == UploadGate::Refusal::Closed);
+  CHECK(gate.enter().refusal == UploadGate::Refusal::Closed);
+  // Moving a pass moves the slot: released once.
+  UploadGate two(2, 0, 4);
+  UploadGate::Entry a = two.enter();
+  std::optional<UploadGate::Pass> moved = std::move(a.pass);
+  a.pass.reset();
+  CHECK(two.busy() == 1);
+  moved.reset();
+  CHECK(two.busy() == 0);
 }
