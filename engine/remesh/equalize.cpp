@@ -28,6 +28,7 @@
 #include "remesh/regularize.h"
 #include "remesh/statistics.h"
 #include "remesh/stellar_operations.h"
+#include "remesh/stopping_rule.h"
 #include "remesh/valence_flips.h"
 
 namespace remesh {
@@ -196,30 +197,6 @@ bool plateaued(const std::vector<IterationStats>& history) {
   return now - then < kPlateauGain || (1.0 - now) > (1.0 - kPlateauShrink) * (1.0 - then);
 }
 
-/// Iterations without a new low of edges outside the interval (cleanup on) before a run stops as
-/// stalled. A stalled run returns the mesh of its low (the fewest edges outside; among those, the
-/// most regular vertices): the count wanders by a few edges around it (cow: 2 edges at iteration
-/// 27, 2 to 9 in the next 6). The span is kStallSpan, or kShortStallSpan once the low is at most
-/// kFewOutside of the edges: a few edges pinned by the input's geometry, which more iterations do
-/// not win (the final cleanup does what can be done). Measured (Table 4.2 setup): a span of 3
-/// instead of 6 gives the same meshes on every refinement run that stalls (cow, cheese, nefertiti,
-/// camelhead, bunny_zipper; 2-3 iterations less, nefertiti 10.8 -> 9.0 s), but ends the
-/// simplifications, which creep down by a few edges every 3-6 iterations, early: bunny 99.95 ->
-/// 99.59 % inside and 85.9 -> 80.4 % regular, cow 95.5 -> 93.4 %, camelhead 99.73 -> 99.56 %.
-/// The share rule kept 6 for those (bunny's low is 0.15 % of its edges until its last iterations),
-/// at 0.1 %. With the interval guard (kSteadyAfter) they no longer creep, and the share is 1 %:
-/// the same meshes on every run of bench --spread (12 meshes refined, 10 simplified) but bunny's
-/// simplification (99.862 -> 99.899 % inside, mean of five), and stalled runs end sooner (cheese
-/// refinement 1.84 -> 1.62 s, cow 0.58 -> 0.55 s, camelhead's simplification 0.52 -> 0.45 s). A span
-/// of 3 everywhere: cheese's simplification 64.75 -> 63.44 % inside, and a small cone
-/// (equalize_test's horn, 3 of its 231 edges outside at the low) stalls instead of converging.
-constexpr int kStallSpan = 6;
-constexpr int kShortStallSpan = 3;
-constexpr double kFewOutside = 0.01;
-int stall_span(std::size_t low, std::size_t edges) {
-  return static_cast<double>(low) <= kFewOutside * static_cast<double>(edges) ? kShortStallSpan : kStallSpan;
-}
-
 /// The final cleanup of a run that ends with edges outside (stalled, or n reached): the mesh it
 /// returns, its low, gets one more interval cleanup, with rounds until one fixes nothing and a
 /// larger patch budget than the per-iteration cleanups (which share max(64, edges / 1000) per
@@ -247,19 +224,6 @@ CleanupCounts run_cleanup(TriMesh& mesh, const ReferenceSurface& reference, cons
   options.rest = final ? nullptr : rest;
   return interval_cleanup(mesh, reference, params.e_min, params.e_max, params.flip_factor, options);
 }
-
-/// Polishing: after the first iteration with every edge inside, iterations go on while they raise
-/// the share of regular vertices: at least one, at most kPolishMax, stopping after an iteration with
-/// every edge inside that gained less than kPolishGain points over the best such mesh, or after
-/// kPolishGrace iterations in a row with an edge outside. The best mesh with every edge inside (most
-/// regular vertices) is returned; a last polished mesh with edges outside but more regular vertices
-/// gets the final cleanup first, and is returned when that puts every edge inside. The cleanup that
-/// wins the last edges back costs regularity (eight: 85.1 % regular at its first convergence), and
-/// one polishing iteration does not always repay it (eight: 87.5 %, spot 89.4 %, kitten 89.2 %;
-/// measured in the Table 4.2 setup).
-constexpr int kPolishMax = 3;
-constexpr double kPolishGain = 0.25;
-constexpr int kPolishGrace = 3;
 
 std::size_t fixes(const CleanupCounts& c) { return c.flips + c.collapses + c.splits + c.relocations + c.patches; }
 
@@ -515,321 +479,286 @@ std::size_t estimate_output_faces(const TriMesh& mesh, const Params& params) {
   return static_cast<std::size_t>(std::ceil(faces));
 }
 
+namespace {
+
+/// One run of equalize(): the mesh, its parameters (as_run's), its reference surface and caches,
+/// and the state the iterations share, with one method per step of an iteration.
+class Run final : private RunMesh {
+ public:
+  /// The setup: garbage collected, normals released, a large mesh numbered in space order, the
+  /// reference surface, its feature points and creases taken from the input.
+  Run(TriMesh& mesh, const Params& params, const OnIteration& on_iteration, std::stop_token stop);
+
+  void relax_reference();
+  void stellar_step(IterationStats& counters);
+  void flip_step(IterationStats& counters);
+  /// Returns false when stopped after the filter (its folds undone; no projection).
+  bool move_step(int i, IterationStats& counters);
+  void cleanup_step(int i, IterationStats& counters);
+  /// The statistics row of iteration i: the mesh measured, with the iteration's counters.
+  IterationStats statistics(int i, IterationStats counters) const;
+  StoppingRule::Verdict judge(int i, IterationStats& row) { return stopping_.judge(i, row, cleanup_started_); }
+  void ending_steps(IterationStats& row);
+  /// Reports the row (StoppingRule::report) and returns the run's outcome after this iteration
+  /// (Completed: it goes on).
+  Outcome report(IterationStats& row, const StoppingRule::Verdict& verdict, Clock::time_point iteration_start);
+  /// The result of a run that ended with `outcome` (the mesh's normals recomputed).
+  Result finish(Outcome outcome);
+
+ private:
+  void take_reference();
+
+  MeshSnapshot snapshot() const override { return MeshSnapshot(mesh_); }
+  void restore(const MeshSnapshot& snapshot) override { restore_snapshot(mesh_, snapshot); }
+  IterationStats measured(const IterationStats& counted) const override {
+    return measured_row(mesh_, params_, counted);
+  }
+  std::size_t final_cleanup(IterationStats& row) override;
+
+  const Clock::time_point start_ = Clock::now();
+  TriMesh& mesh_;
+  const Params params_;
+  std::stop_token stop_;
+  const double m_ = 0.5 * (params_.e_min + params_.e_max);
+  const double sigma_ = main_phase_sigma(params_);
+  Result result_;
+  PhaseSeconds& phases_ = result_.phases;
+  std::vector<NeighbourCache> caches_;   // per vertex, for the projection (projection.h)
+  std::size_t renumbered_since_ = 0;     // splits and collapses since (kOrderShare)
+  double on_crease_ = 0;                 // crease_tolerance
+  std::unique_ptr<ReferenceSurface> reference_;
+  std::unique_ptr<FeatureSnap> features_;
+  std::unique_ptr<CreaseLines> creases_;
+  std::unique_ptr<CreaseGuard> guard_;   // with Params::keep_creases
+  PatchRest patch_rest_;                 // the per-iteration cleanups' memory of failed patch relaxations
+  std::vector<IterationStats> history_;  // the row of each iteration (plateaued)
+  bool cleanup_started_ = false;         // the full cleanup, once started, runs in every iteration
+  int cleanup_from_ = 0;                 // the iteration it started in (0: not yet)
+  StoppingRule stopping_;
+};
+
+}  // namespace
+
 Result equalize(TriMesh& mesh, const Params& requested, const OnIteration& on_iteration, std::stop_token stop) {
   check_preconditions(mesh, requested);
   const Params params = as_run(mesh, requested);
-  const auto start = Clock::now();
-  const unsigned threads = params.threads;
-  const double m = 0.5 * (params.e_min + params.e_max);
-  const double sigma = main_phase_sigma(params);
-  Result result;
-  PhaseSeconds& phases = result.phases;
-  PhaseTimer setup_timer(phases.setup);
-  collect_garbage(mesh);
-  release_normals(mesh);
-  std::vector<NeighbourCache> neighbour_caches;  // per vertex, for the projection (projection.h)
-  if (mesh.n_vertices() >= kOrderMinVertices) order_in_space(mesh, neighbour_caches, threads);
-  std::size_t renumbered_since = 0;  // splits and collapses since (kOrderShare)
-  auto reference = std::make_unique<ReferenceSurface>(mesh);
-  auto features = std::make_unique<FeatureSnap>(mesh, crease_spacing(params));
-  auto creases = std::make_unique<CreaseLines>(mesh);
-  const double on_crease = crease_tolerance(mesh);
-  // With Params::keep_creases, the rule that keeps them (crease_lines.h); none without creases.
-  auto guard_of = [&](const CreaseLines& lines) {
-    return !params.keep_creases || lines.empty() ? nullptr : std::make_unique<CreaseGuard>(lines, on_crease);
-  };
-  std::unique_ptr<CreaseGuard> guard = guard_of(*creases);
-  PatchRest patch_rest(mesh);  // the per-iteration cleanups' memory of failed patch relaxations
-  setup_timer.stop();
-
-  std::vector<IterationStats> history;  // the row of each iteration (plateaued)
-  bool cleanup_started = false;        // the full cleanup, once started, runs in every iteration
-  int cleanup_from = 0;                // the iteration it started in (0: not yet)
-  std::size_t fewest_outside = SIZE_MAX;  // fewest edges outside the interval since then, and when
-  int fewest_at = 0;
-  // Polishing (see kPolishMax): when it began, and the best mesh so far with every edge inside.
-  struct Converged {
-    MeshSnapshot mesh;
-    IterationStats row;
-  };
-  std::optional<Converged> best;
-  std::optional<Converged> fewest;  // the mesh of the low of edges outside, once the cleanup runs
-  int converged_at = 0, outside_since = 0;  // first convergence; iterations in a row with edges outside
-  std::vector<IterationStats> held;  // rows of the polishing iterations, not yet reported
-  // A run that ends with edges outside (stalled, or n reached; with run_all_iterations, any run at
-  // its n-th iteration) returns the mesh of its low: `row` (this iteration's, `outside` edges
-  // outside) then describes it (its counters stay this iteration's), so that the last row is the
-  // returned mesh's. Then the final cleanup (kFinalCleanupRounds) works on it.
-  auto end_at_low = [&](IterationStats& row, std::size_t outside) {
-    const std::size_t low = fewest ? fewest->row.small + fewest->row.big : SIZE_MAX;
-    if (low < outside || (low == outside && fewest->row.regular_percent > row.regular_percent)) {
-      restore_snapshot(mesh, fewest->mesh);
-      row = measured_row(mesh, params, row);
-    }
-    if (stop.stop_requested() || row.small + row.big == 0) return;
-    PhaseTimer timer(phases.cleanup);
-    const CleanupCounts c = run_cleanup(mesh, *reference, params, neighbour_caches, guard.get(), /*final=*/true,
-                                        /*boundary_only=*/false, stop);
-    timer.stop();
-    if (fixes(c) > 0) {
-      count_cleanup(row, c);
-      row = measured_row(mesh, params, row);
-    }
-  };
-  auto flush = [&] {
-    if (on_iteration)
-      for (const IterationStats& r : held) on_iteration(r);
-    held.clear();
-  };
+  Run run(mesh, params, on_iteration, stop);
   for (int i = 1; i <= params.iterations; ++i) {
-    if (stop.stop_requested()) {
-      result.outcome = Outcome::Cancelled;
-      break;
-    }
+    if (stop.stop_requested()) return run.finish(Outcome::Cancelled);
     const auto iteration_start = Clock::now();
-    IterationStats counters;
-    if (params.relax_every > 0 && i % params.relax_every == 0) {
-      const PhaseTimer timer(phases.setup);
-      reference = std::make_unique<ReferenceSurface>(mesh);
-      features = std::make_unique<FeatureSnap>(mesh, crease_spacing(params));
-      creases = std::make_unique<CreaseLines>(mesh);
-      guard = guard_of(*creases);
-    }
-
-    // Algorithms 2 and 3: stellar operations on the priority list.
-    {
-      const PhaseTimer timer(phases.stellar);
-      const double m_i = std::min(2.0 * mean_edge_length(mesh, threads), m);
-      const double sigma_i = band_at(sigma, m_i);
-      const std::vector<unsigned> list = make_priority_list(mesh, m_i, sigma_i, threads);
-      std::vector<OpenMesh::VertexHandle> placed;
-      const StellarCounts stellar = stellar_operations(mesh, list, m_i, sigma_i, guard.get(), &placed);
-      // Not in the thesis: the points the splits and collapses chose on their edges (eq. 3.1) go
-      // onto the reference now, not only after the filter (Algorithm 6). The fold guard puts a
-      // vertex back where it was before the filter, which for a new vertex was on its edge's chord,
-      // under the surface; a vertex the guard held stayed there, iteration after iteration (cow
-      // refined: vertices up to 0.62 units off the surface in every iteration from the 14th, 0.33
-      // in the returned mesh; after this, 0.06 in the iterations). Before the flips, which see the
-      // projected points: after them, the Hausdorff distances came out between and cheese's
-      // simplification crossed more. Measured: bench/README.md, "Vertices kept on the surface".
-      project_vertices(mesh, placed, *reference, threads, &neighbour_caches);
-      collect_garbage(mesh);
-      renumbered_since += stellar.splits + stellar.collapses;
-      if (mesh.n_vertices() >= kOrderMinVertices &&
-          static_cast<double>(renumbered_since) >= kOrderShare * static_cast<double>(mesh.n_vertices())) {
-        order_in_space(mesh, neighbour_caches, threads);
-        renumbered_since = 0;
-      }
-      counters.splits = stellar.splits;
-      counters.collapses = stellar.collapses;
-    }
-    if (stop.stop_requested()) {
-      result.outcome = Outcome::Cancelled;
-      break;
-    }
-
-    // Algorithm 4: valence-improving flips.
-    {
-      const PhaseTimer timer(phases.flips);
-      counters.flips = valence_flips(mesh, params.flip_factor, kFlipSweeps, threads, guard.get());
-      // Not in the thesis: the look-ahead flips that let 5-7 pairs cancel (regularize.h).
-      if (params.cleanup) {
-        const RegularizeCounts r =
-            regularize(mesh, params.flip_factor, kRegularizeSweeps, threads, guard.get(), params.more_regular ? 2 : 1);
-        counters.flips += r.single + r.chain_flips;
-      }
-    }
-    if (stop.stop_requested()) {
-      result.outcome = Outcome::Cancelled;
-      break;
-    }
-
-    // Algorithm 5 then 6: filter and projection, guarded against folds as one move (not in the
-    // thesis: fold_guard.h).
-    PhaseTimer move_timer(phases.filter);
-    const std::vector<Vec3> before = snapshot_points(mesh);
-    // Not in the thesis: until the cleanup starts (and in the first half of the iterations with the
-    // cleanup off), vertices on the reference's creases move
-    // along them only (crease_lines.h). The creases are lost, if at all, in the first iterations,
-    // while the mesh is coarse and the filter's moves are long; held in every iteration they cost
-    // freedom: cheese's refinement had 34 crossing face pairs over the five intervals of bench
-    // --spread (0 at [1.2, 1.8]) where it has 7 without the rule and 10 with it held until the cleanup.
-    const bool hold_creases = guard || (cleanup_from == 0 && 2 * i <= params.iterations);
-    low_pass_filter(mesh, params.rings, threads, hold_creases ? creases.get() : nullptr, on_crease);
-    if (stop.stop_requested()) {
-      move_timer.switch_to(phases.guards);
-      undo_folds(mesh, before, threads);
-      result.outcome = Outcome::Cancelled;
-      break;
-    }
-    move_timer.switch_to(phases.projection);
-    counters.max_projection_distance = project_onto_reference(mesh, *reference, threads, &neighbour_caches);
-    move_timer.switch_to(phases.guards);
-    undo_folds(mesh, before, threads);
-    // Not in the thesis: once the interval cleanup has run for kSteadyAfter iterations, the filter
-    // and projection may not take an edge out of the interval (nor fold a face, as before), while
-    // the run keeps reaching new lows of edges outside (kExploreAfter) and has not converged.
-    if (params.cleanup && cleanup_from > 0 && i - cleanup_from >= kSteadyAfter && !best &&
-        i - 1 - fewest_at < kExploreAfter)
-      while (undo_interval_breaks(mesh, before, params.e_min, params.e_max, 3, reference.get(), &neighbour_caches) > 0 &&
-             undo_folds(mesh, before, threads) > 0) {
-      }
-    move_timer.stop();
-
-    // Not in the thesis: the post-process its conclusion asks for (interval_cleanup.h). It runs in
-    // the last iteration, and in every iteration once at least kCleanupFrom of the edges are inside,
-    // the main phase has plateaued or half the iterations are done, so that a run reaches every edge
-    // inside and stops early (convergence) instead of wandering around 99.6 % (or, when
-    // simplifying, around 88 %).
-    // On open meshes its boundary part runs every iteration (see interval_cleanup.h).
-    if (params.cleanup && !stop.stop_requested()) {
-      const bool last = i == params.iterations;
-      cleanup_started = cleanup_started || 2 * i > params.iterations || plateaued(history) ||
-                        inside_fraction(mesh, params, threads) >= kCleanupFrom;
-      if (cleanup_started && cleanup_from == 0) cleanup_from = i;
-      const bool full = last || cleanup_started;
-      if (full || reference->has_boundary()) {
-        const PhaseTimer timer(phases.cleanup);
-        const CleanupCounts c = run_cleanup(mesh, *reference, params, neighbour_caches, guard.get(), /*final=*/false,
-                                            /*boundary_only=*/!full, stop, &patch_rest);
-        count_cleanup(counters, c);
-        renumbered_since += c.splits + c.collapses;
-      }
-    }
-
-    counters.iteration = i;
-    IterationStats row = measured_row(mesh, params, counters);
-    // Is this the last iteration? Converged: every edge inside; with the cleanup on, after the
-    // polishing iterations (kPolishMax), returning the polished mesh with the most regular vertices.
-    // Stalled: with the cleanup on, the count of edges outside has not reached a new low for
-    // stall_span() iterations (a few edges pinned by the input's geometry, e.g. where two sheets
-    // touch): more iterations would change nothing but the time spent.
-    const bool all_inside = row.small == 0 && row.big == 0;
-    Outcome outcome = Outcome::Completed;
-    bool restore = false;
-    const std::size_t outside = row.small + row.big;
-    if (cleanup_started && outside < fewest_outside) fewest_outside = outside, fewest_at = i;
-    // Keep the mesh of the low until the first mesh with every edge inside (then `best` is returned);
-    // with run_all_iterations, which has no `best`, through the whole run, meshes with every edge
-    // inside included.
-    if (cleanup_started && (!all_inside || params.run_all_iterations) && !best && params.cleanup &&
-        outside == fewest_outside &&
-        (!fewest || fewest->row.small + fewest->row.big > outside ||
-         row.regular_percent > fewest->row.regular_percent))
-      fewest = Converged{MeshSnapshot(mesh), row};
-    if (!params.run_all_iterations && params.cleanup) {
-      if (all_inside && !best) {
-        best = Converged{MeshSnapshot(mesh), row};
-        converged_at = i;
-        fewest.reset();  // no longer needed
-      } else if (best) {
-        const bool gained = all_inside && row.regular_percent >= best->row.regular_percent + kPolishGain;
-        outside_since = all_inside ? 0 : outside_since + 1;
-        if (all_inside && !gained) {
-          outcome = Outcome::Converged;
-          restore = row.regular_percent < best->row.regular_percent;
-        } else if (i - converged_at >= kPolishMax || outside_since >= kPolishGrace || i == params.iterations) {
-          outcome = Outcome::Converged;
-          // The last polished mesh, with a few edges outside but more regular vertices than the
-          // best, gets the final cleanup (kFinalCleanupRounds) before the best is restored instead.
-          // Measured (bench --spread, 120 runs): bunny refined at [1.2, 1.8] 87.82 -> 89.67 %
-          // regular (its three polishing iterations reached 89.1-89.6 % with 1-2 edges outside),
-          // fandisk simplified at [1.21, 1.81] 85.37 -> 87.30 %; the 118 other runs unchanged.
-          // The final cleanup in every polishing iteration instead stopped some polishing sooner:
-          // 16 other runs changed, 12 of them for the worse (eight -0.4, fandisk -0.4 points).
-          bool inside_now = all_inside;
-          if (!all_inside && row.regular_percent >= best->row.regular_percent + kPolishGain && !stop.stop_requested()) {
-            PhaseTimer timer(phases.cleanup);
-            const CleanupCounts c = run_cleanup(mesh, *reference, params, neighbour_caches, guard.get(), /*final=*/true,
-                                                /*boundary_only=*/false, stop);
-            timer.stop();
-            count_cleanup(row, c);
-            row = measured_row(mesh, params, row);
-            inside_now = row.small == 0 && row.big == 0;
-          }
-          restore = !inside_now || row.regular_percent < best->row.regular_percent;
-        } else if (gained) {
-          best = Converged{MeshSnapshot(mesh), row};
-          flush();  // the rows before this one stand
-        }
-      } else if (cleanup_started && i - fewest_at >= stall_span(fewest_outside, row.edges)) {
-        outcome = Outcome::Stalled;
-      }
-      if (!best && (outcome == Outcome::Stalled || i == params.iterations)) end_at_low(row, outside);
-    } else if (params.run_all_iterations && params.cleanup) {
-      // No early stop (the outcome stays Completed); the n-th iteration ends as a run that reaches
-      // n does, at its low.
-      if (i == params.iterations) end_at_low(row, outside);
-    } else if (!params.run_all_iterations && all_inside) {
-      outcome = Outcome::Converged;
-    }
-    if (restore) {
-      restore_snapshot(mesh, best->mesh);
-      row = best->row;
-      held.clear();
-    }
-    const bool ending = outcome != Outcome::Completed || i == params.iterations;
-    // Not in the thesis: before the mesh is returned, the reference vertices it cuts off (tips,
-    // creases) are put back on it (feature_snap.h); no edge leaves the interval.
-    if (ending && params.cleanup && !stop.stop_requested()) {
-      // The neighbour caches are done with (the snap's relaxations keep their own; a mending
-      // cleanup after the untangling goes without, exact either way): freed before the snap
-      // builds its index of the mesh, they no longer add to the run's peak (nefertiti: 28 of
-      // its 119 MB there).
-      std::vector<NeighbourCache>().swap(neighbour_caches);
-      PhaseTimer timer(phases.snap);
-      const std::size_t snapped = features->apply(mesh, *reference, params.e_min, params.e_max, threads, guard.get());
-      timer.stop();
-      const std::size_t fixes_before = row.cleanup_fixes;
-      row.cleanup_fixes += snapped;
-      const Crossings crossings =
-          untangle_and_mend(mesh, *reference, params, neighbour_caches, guard.get(), row, phases, stop);
-      result.crossing_pairs = crossings.pairs;
-      result.layered = crossings.layered;
-      if (row.cleanup_fixes != fixes_before) row = measured_row(mesh, params, row);
-    }
-    // The outcome of a run that stopped early describes the mesh returned, which this row does: the
-    // final cleanup or the untangling's can mend a stalled run's last edges (nefertiti's
-    // simplification), and the untangling's last round can leave an edge outside.
-    if (outcome == Outcome::Stalled || outcome == Outcome::Converged)
-      outcome = row.small + row.big == 0 ? Outcome::Converged : Outcome::Stalled;
-    // A stop asked for during the last iteration's ending steps (the final cleanup cut short, the
-    // snap and the untangling skipped) is a cancelled run, not a finished one: the caller must not
-    // take the mesh for a result (the service marked such a job succeeded, the CLI exited 0).
-    if (ending && stop.stop_requested()) outcome = Outcome::Cancelled;
-    row.seconds = restore ? best->row.seconds : seconds_since(iteration_start);
-    result.iterations_done = row.iteration;
-    history.push_back(row);
-    // Rows of the polishing iterations wait until it is known whether they stand (rows after the
-    // best mesh do not when it is restored).
-    if (best && !ending) {
-      held.push_back(row);
-    } else {
-      flush();
-      if (on_iteration) on_iteration(row);
-    }
-    if (outcome != Outcome::Completed) {
-      result.outcome = outcome;
-      break;
-    }
+    IterationStats counters;  // this iteration's splits, collapses, flips, cleanup fixes
+    if (params.relax_every > 0 && i % params.relax_every == 0) run.relax_reference();
+    run.stellar_step(counters);  // Algorithms 2 and 3, on the priority list
+    if (stop.stop_requested()) return run.finish(Outcome::Cancelled);
+    run.flip_step(counters);  // Algorithm 4
+    if (stop.stop_requested()) return run.finish(Outcome::Cancelled);
+    if (!run.move_step(i, counters)) return run.finish(Outcome::Cancelled);  // Algorithms 5 and 6
+    run.cleanup_step(i, counters);
+    IterationStats row = run.statistics(i, counters);
+    const StoppingRule::Verdict verdict = run.judge(i, row);  // converged, stalled, n reached?
+    if (verdict.ending && params.cleanup && !stop.stop_requested()) run.ending_steps(row);
+    const Outcome outcome = run.report(row, verdict, iteration_start);
+    if (outcome != Outcome::Completed) return run.finish(outcome);
   }
-  flush();
-  mesh.request_vertex_normals();
-  mesh.request_face_normals();
-  mesh.update_normals();
+  return run.finish(Outcome::Completed);
+}
+
+namespace {
+
+Run::Run(TriMesh& mesh, const Params& params, const OnIteration& on_iteration, std::stop_token stop)
+    : mesh_(mesh),
+      params_(params),
+      stop_(std::move(stop)),
+      patch_rest_(mesh),
+      stopping_(*this, params_, on_iteration, stop_) {
+  const PhaseTimer timer(phases_.setup);
+  collect_garbage(mesh_);
+  release_normals(mesh_);
+  if (mesh_.n_vertices() >= kOrderMinVertices) order_in_space(mesh_, caches_, params_.threads);
+  on_crease_ = crease_tolerance(mesh_);
+  take_reference();
+}
+
+/// The reference surface, its feature points and creases, taken from the mesh as it is.
+void Run::take_reference() {
+  reference_ = std::make_unique<ReferenceSurface>(mesh_);
+  features_ = std::make_unique<FeatureSnap>(mesh_, crease_spacing(params_));
+  creases_ = std::make_unique<CreaseLines>(mesh_);
+  // With Params::keep_creases, the rule that keeps them (crease_lines.h); none without creases.
+  guard_ = !params_.keep_creases || creases_->empty() ? nullptr : std::make_unique<CreaseGuard>(*creases_, on_crease_);
+}
+
+/// Every pr iterations (Params::relax_every): the reference is the current mesh.
+void Run::relax_reference() {
+  const PhaseTimer timer(phases_.setup);
+  take_reference();
+}
+
+/// Algorithms 2 and 3: stellar operations on the priority list.
+void Run::stellar_step(IterationStats& counters) {
+  const PhaseTimer timer(phases_.stellar);
+  const unsigned threads = params_.threads;
+  const double m_i = std::min(2.0 * mean_edge_length(mesh_, threads), m_);
+  const double sigma_i = band_at(sigma_, m_i);
+  const std::vector<unsigned> list = make_priority_list(mesh_, m_i, sigma_i, threads);
+  std::vector<OpenMesh::VertexHandle> placed;
+  const StellarCounts stellar = stellar_operations(mesh_, list, m_i, sigma_i, guard_.get(), &placed);
+  // Not in the thesis: the points the splits and collapses chose on their edges (eq. 3.1) go
+  // onto the reference now, not only after the filter (Algorithm 6). The fold guard puts a
+  // vertex back where it was before the filter, which for a new vertex was on its edge's chord,
+  // under the surface; a vertex the guard held stayed there, iteration after iteration (cow
+  // refined: vertices up to 0.62 units off the surface in every iteration from the 14th, 0.33
+  // in the returned mesh; after this, 0.06 in the iterations). Before the flips, which see the
+  // projected points: after them, the Hausdorff distances came out between and cheese's
+  // simplification crossed more. Measured: bench/README.md, "Vertices kept on the surface".
+  project_vertices(mesh_, placed, *reference_, threads, &caches_);
+  collect_garbage(mesh_);
+  renumbered_since_ += stellar.splits + stellar.collapses;
+  if (mesh_.n_vertices() >= kOrderMinVertices &&
+      static_cast<double>(renumbered_since_) >= kOrderShare * static_cast<double>(mesh_.n_vertices())) {
+    order_in_space(mesh_, caches_, threads);
+    renumbered_since_ = 0;
+  }
+  counters.splits = stellar.splits;
+  counters.collapses = stellar.collapses;
+}
+
+/// Algorithm 4: valence-improving flips.
+void Run::flip_step(IterationStats& counters) {
+  const PhaseTimer timer(phases_.flips);
+  counters.flips = valence_flips(mesh_, params_.flip_factor, kFlipSweeps, params_.threads, guard_.get());
+  // Not in the thesis: the look-ahead flips that let 5-7 pairs cancel (regularize.h).
+  if (params_.cleanup) {
+    const RegularizeCounts r = regularize(mesh_, params_.flip_factor, kRegularizeSweeps, params_.threads,
+                                          guard_.get(), params_.more_regular ? 2 : 1);
+    counters.flips += r.single + r.chain_flips;
+  }
+}
+
+/// Algorithm 5 then 6: filter and projection, guarded against folds as one move (not in the
+/// thesis: fold_guard.h).
+bool Run::move_step(int i, IterationStats& counters) {
+  const unsigned threads = params_.threads;
+  PhaseTimer timer(phases_.filter);
+  const std::vector<Vec3> before = snapshot_points(mesh_);
+  // Not in the thesis: until the cleanup starts (and in the first half of the iterations with the
+  // cleanup off), vertices on the reference's creases move along them only (crease_lines.h). The
+  // creases are lost, if at all, in the first iterations, while the mesh is coarse and the filter's
+  // moves are long; held in every iteration they cost freedom: cheese's refinement had 34 crossing
+  // face pairs over the five intervals of bench --spread (0 at [1.2, 1.8]) where it has 7 without
+  // the rule and 10 with it held until the cleanup.
+  const bool hold_creases = guard_ || (cleanup_from_ == 0 && 2 * i <= params_.iterations);
+  low_pass_filter(mesh_, params_.rings, threads, hold_creases ? creases_.get() : nullptr, on_crease_);
+  if (stop_.stop_requested()) {
+    timer.switch_to(phases_.guards);
+    undo_folds(mesh_, before, threads);
+    return false;
+  }
+  timer.switch_to(phases_.projection);
+  counters.max_projection_distance = project_onto_reference(mesh_, *reference_, threads, &caches_);
+  timer.switch_to(phases_.guards);
+  undo_folds(mesh_, before, threads);
+  // Not in the thesis: once the interval cleanup has run for kSteadyAfter iterations, the filter
+  // and projection may not take an edge out of the interval (nor fold a face, as before), while
+  // the run keeps reaching new lows of edges outside (kExploreAfter) and has not converged.
+  if (params_.cleanup && cleanup_from_ > 0 && i - cleanup_from_ >= kSteadyAfter && !stopping_.polishing() &&
+      i - 1 - stopping_.last_low() < kExploreAfter)
+    while (undo_interval_breaks(mesh_, before, params_.e_min, params_.e_max, 3, reference_.get(), &caches_) > 0 &&
+           undo_folds(mesh_, before, threads) > 0) {
+    }
+  return true;
+}
+
+/// Not in the thesis: the post-process its conclusion asks for (interval_cleanup.h). It runs in
+/// the last iteration, and in every iteration once at least kCleanupFrom of the edges are inside,
+/// the main phase has plateaued or half the iterations are done, so that a run reaches every edge
+/// inside and stops early (convergence) instead of wandering around 99.6 % (or, when
+/// simplifying, around 88 %).
+/// On open meshes its boundary part runs every iteration (see interval_cleanup.h).
+void Run::cleanup_step(int i, IterationStats& counters) {
+  if (!params_.cleanup || stop_.stop_requested()) return;
+  const bool last = i == params_.iterations;
+  cleanup_started_ = cleanup_started_ || 2 * i > params_.iterations || plateaued(history_) ||
+                     inside_fraction(mesh_, params_, params_.threads) >= kCleanupFrom;
+  if (cleanup_started_ && cleanup_from_ == 0) cleanup_from_ = i;
+  const bool full = last || cleanup_started_;
+  if (!full && !reference_->has_boundary()) return;
+  const PhaseTimer timer(phases_.cleanup);
+  const CleanupCounts c = run_cleanup(mesh_, *reference_, params_, caches_, guard_.get(), /*final=*/false,
+                                      /*boundary_only=*/!full, stop_, &patch_rest_);
+  count_cleanup(counters, c);
+  renumbered_since_ += c.splits + c.collapses;
+}
+
+IterationStats Run::statistics(int i, IterationStats counters) const {
+  counters.iteration = i;
+  return measured_row(mesh_, params_, counters);
+}
+
+/// Not in the thesis: before the mesh is returned, the reference vertices it cuts off (tips,
+/// creases) are put back on it (feature_snap.h); no edge leaves the interval. Then faces that cross
+/// each other are moved apart (untangle_and_mend).
+void Run::ending_steps(IterationStats& row) {
+  // The neighbour caches are done with (the snap's relaxations keep their own; a mending
+  // cleanup after the untangling goes without, exact either way): freed before the snap
+  // builds its index of the mesh, they no longer add to the run's peak (nefertiti: 28 of
+  // its 119 MB there).
+  std::vector<NeighbourCache>().swap(caches_);
+  PhaseTimer timer(phases_.snap);
+  const std::size_t snapped =
+      features_->apply(mesh_, *reference_, params_.e_min, params_.e_max, params_.threads, guard_.get());
+  timer.stop();
+  const std::size_t fixes_before = row.cleanup_fixes;
+  row.cleanup_fixes += snapped;
+  const Crossings crossings =
+      untangle_and_mend(mesh_, *reference_, params_, caches_, guard_.get(), row, phases_, stop_);
+  result_.crossing_pairs = crossings.pairs;
+  result_.layered = crossings.layered;
+  if (row.cleanup_fixes != fixes_before) row = measured_row(mesh_, params_, row);
+}
+
+Outcome Run::report(IterationStats& row, const StoppingRule::Verdict& verdict, Clock::time_point iteration_start) {
+  // Taken before the row is reported: a stop that on_iteration asks for is seen at the next
+  // iteration's start, so the run ends with the iterations it reported.
+  const Outcome outcome = stopping_.outcome(verdict, row);
+  row.seconds = verdict.restored ? stopping_.best_row().seconds : seconds_since(iteration_start);
+  result_.iterations_done = row.iteration;
+  history_.push_back(row);
+  stopping_.report(row, verdict.ending);
+  return outcome;
+}
+
+std::size_t Run::final_cleanup(IterationStats& row) {
+  PhaseTimer timer(phases_.cleanup);
+  const CleanupCounts c = run_cleanup(mesh_, *reference_, params_, caches_, guard_.get(), /*final=*/true,
+                                      /*boundary_only=*/false, stop_);
+  timer.stop();
+  count_cleanup(row, c);
+  return fixes(c);
+}
+
+Result Run::finish(Outcome outcome) {
+  result_.outcome = outcome;
+  stopping_.flush();
+  mesh_.request_vertex_normals();
+  mesh_.request_face_normals();
+  mesh_.update_normals();
+  const bool cancelled = outcome == Outcome::Cancelled;
   // Measured for the result only: a cancelled run has none (and its caller is waiting).
-  if (result.outcome != Outcome::Cancelled)
-    result.thin = thin_parts(mesh, *reference, params.e_min, params.e_max, threads, guard.get());
+  if (!cancelled)
+    result_.thin = thin_parts(mesh_, *reference_, params_.e_min, params_.e_max, params_.threads, guard_.get());
   // A run without the untangling (cleanup off, or stopped before it) counts them here; a cancelled
   // one leaves them unknown.
-  if (!result.crossing_pairs && !result.layered && result.outcome != Outcome::Cancelled) {
-    const auto crossing = find_self_intersections_unless_layered(mesh, threads);
-    result.layered = !crossing;
-    if (crossing) result.crossing_pairs = crossing->size();
+  if (!result_.crossing_pairs && !result_.layered && !cancelled) {
+    const auto crossing = find_self_intersections_unless_layered(mesh_, params_.threads);
+    result_.layered = !crossing;
+    if (crossing) result_.crossing_pairs = crossing->size();
   }
-  if (result.outcome != Outcome::Cancelled) result.triangles = triangle_quality(mesh);
-  result.seconds = seconds_since(start);
-  return result;
+  if (!cancelled) result_.triangles = triangle_quality(mesh_);
+  result_.seconds = seconds_since(start_);
+  return result_;
 }
+
+}  // namespace
 
 }  // namespace remesh

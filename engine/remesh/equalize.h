@@ -51,7 +51,7 @@ struct IterationStats {
 using OnIteration = std::function<void(const IterationStats&)>;
 
 /// Completed: ran all iterations. Converged: stopped early with every edge inside [e_min, e_max].
-/// Stalled: stopped early because the count of edges outside stopped falling (see equalize.cpp),
+/// Stalled: stopped early because the count of edges outside stopped falling (stopping_rule.h),
 /// with edges outside left. (A stalled run whose last step mends its last edges is Converged.)
 /// Cancelled: the stop token was triggered. Only Completed happens with run_all_iterations.
 enum class Outcome { Completed, Converged, Stalled, Cancelled };

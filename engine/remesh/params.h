@@ -27,13 +27,14 @@ struct Params {
   /// Not in the thesis: (1) fix the remaining edges outside [e_min, e_max] by local flips,
   /// collapses, splits, vertex and patch relocations (interval_cleanup.h), the post-process the
   /// thesis' conclusion asks for; (2) after Algorithm 4, the look-ahead flips that let 5-7 pairs
-  /// cancel (regularize.h). With it go the filter's interval guard (kSteadyAfter), the polishing
-  /// and the return of the best mesh (kPolishMax), the stall stop, the feature snap and the
-  /// untangling (equalize.cpp). false is not the thesis' method alone: the additions inside its
-  /// steps stay (the collapse length limit and tips kept by collapses, stellar_operations.h; corners
-  /// held by the filter, low_pass_filter.h; three flip sweeps; the fold guard, fold_guard.h; placed
-  /// points projected at once; boundary vertices projected onto the boundary curves, projection.h;
-  /// creases followed in the first half of the iterations, crease_lines.h).
+  /// cancel (regularize.h). With it go the filter's interval guard (kSteadyAfter), the feature
+  /// snap and the untangling (equalize.cpp), the polishing and the return of the best mesh
+  /// (kPolishMax) and the stall stop (stopping_rule.h). false is not the thesis' method alone: the
+  /// additions inside its steps stay (the collapse length limit and tips kept by collapses,
+  /// stellar_operations.h; corners held by the filter, low_pass_filter.h; three flip sweeps; the
+  /// fold guard, fold_guard.h; placed points projected at once; boundary vertices projected onto
+  /// the boundary curves, projection.h; creases followed in the first half of the iterations,
+  /// crease_lines.h).
   bool cleanup = true;
   /// Not in the thesis: the interval cleanup keeps tips (is_tip in stellar_operations.h: ears,
   /// horns, spikes) where they are, as the stellar operations always do: none of its collapses,
