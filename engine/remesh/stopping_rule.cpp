@@ -161,6 +161,9 @@ Outcome StoppingRule::outcome(const Verdict& verdict, const IterationStats& row)
 }
 
 void StoppingRule::report(const IterationStats& row, bool ending) {
+  // The best mesh's row was kept before its iteration's seconds were known: restored, it was
+  // reported with 0 seconds.
+  if (best_ && best_->row.iteration == row.iteration) best_->row.seconds = row.seconds;
   // Rows of the polishing iterations wait until it is known whether they stand (rows after the
   // best mesh do not when it is restored).
   if (best_ && !ending) {

@@ -359,6 +359,8 @@ TEST_CASE("a converged run returns its most regular mesh with every edge inside"
     INFO("mean edge " << scale << ", " << rows.size() << " rows, last iteration " << last.iteration);
     CHECK(last.small + last.big == 0);
     CHECK(test::plain_inside_fraction(mesh, 1.2, 1.8) == 1.0);
+    // Every row has its iteration's seconds, the best mesh's restored row too (it had 0).
+    for (const IterationStats& row : rows) CHECK(row.seconds > 0);
     for (std::size_t k = 0; k + 1 < rows.size(); ++k) {
       CHECK(rows[k].iteration < rows[k + 1].iteration);
       if (rows[k].small + rows[k].big == 0) CHECK(rows[k].regular_percent <= last.regular_percent);
