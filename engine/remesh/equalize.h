@@ -21,6 +21,7 @@
 
 #include "core/mesh.h"
 #include "remesh/params.h"
+#include "remesh/preconditions.h"  // the checks equalize() makes first, as_run
 #include "remesh/thin_parts.h"
 #include "remesh/triangle_quality.h"
 
@@ -121,12 +122,6 @@ struct Result {
   std::optional<TriangleQuality> triangles;
 };
 
-/// Estimated face count of the output: area / (sqrt(3)/4 * m^2), m = (e_min + e_max) / 2, e_max at
-/// most the bounding-box diagonal (as equalize() takes it).
-std::size_t estimate_output_faces(const TriMesh& mesh, const Params& params);
-/// The largest estimate_output_faces() gives: past it (or not finite), it gives this.
-inline constexpr std::size_t kMaxFaceEstimate = 1'000'000'000'000'000'000;
-
 /// The spacing of the feature snap's points along the reference's creases (feature_snap.h): e_min,
 /// but never less than a quarter of m = (e_min + e_max) / 2. With [1.2, 1.8] it is e_min; an
 /// interval like [1e-7, 1] would otherwise put a point every 1e-7 along every crease, hundreds of
@@ -134,39 +129,10 @@ inline constexpr std::size_t kMaxFaceEstimate = 1'000'000'000'000'000'000;
 /// near 0.5.
 double crease_spacing(const Params& params);
 
-/// The parameters a run uses: e_max at most the mesh's bounding-box diagonal. No edge on the
-/// surface is longer, so the same edges are inside, and the steps that aim at (e_min + e_max) / 2
-/// aim at a length the surface has (an e_max of 1e300 made eq. 3.1 overflow to NaN positions).
-Params as_run(const TriMesh& mesh, const Params& params);
-
-/// Length of the diagonal of the box around the mesh's vertices (0 for an empty mesh).
-double bounding_box_diagonal(const TriMesh& mesh);
-
-/// The sizes of mesh the remesher works at: its bounding-box diagonal within these bounds. Past
-/// them areas and products of lengths underflow or overflow (a tetrahedron 1e100 across was
-/// "too large: 1e18 faces"; 1e-200 across had a diagonal of 0; a tetrahedron 1e-100 across ended
-/// 81 % inside where at size 1 it ends 100 %; spot gives the same figures from 1e-28 to 1e28 across).
-inline constexpr double kMinMeshSize = 1e-30, kMaxMeshSize = 1e30;
-
-/// Throws MeshError, saying how large the mesh is, when its bounding-box diagonal lies outside
-/// [kMinMeshSize, kMaxMeshSize] (or is not finite).
-void check_mesh_size(const TriMesh& mesh);
-
-/// Throws MeshError when an interior vertex has fewer than three faces around it. Such a vertex
-/// has two, over the same three corners: a component that is one flat "pillow" of two triangles
-/// back to back (a tetrahedron whose two corners coincide reads so once its zero-area faces are
-/// repaired), which encloses nothing and which no flip, split or collapse can work on (OpenMesh
-/// asserted in a flip; other such inputs came out non-manifold).
-void check_vertex_stars(const TriMesh& mesh);
-
-/// What check(params) cannot judge without the mesh: e_min must be shorter than the mesh's
-/// bounding-box diagonal, since no edge between two points of its surface is longer (no edge could
-/// end inside the interval). Every invalid field, named as check() names them; empty when valid.
-std::vector<FieldError> check_against(const TriMesh& mesh, const Params& params);
-
 /// Remeshes `mesh` in place. Preconditions: a valid 2-manifold, consistently oriented TriMesh (as
-/// read_mesh returns). Throws ParamsError if check(params) or check_against(mesh, params) fails,
-/// LimitError if the estimated output exceeds params.max_output_faces. Runs with as_run(mesh,
+/// read_mesh returns). Throws what check_preconditions() throws (preconditions.h): ParamsError if
+/// check(params) or check_against(mesh, params) fails, LimitError if the estimated output exceeds
+/// params.max_output_faces. Runs with as_run(mesh,
 /// params). `on_iteration` runs on the calling thread after each iteration.
 /// A stop request is honoured between phases; the mesh is valid whenever this returns.
 Result equalize(TriMesh& mesh, const Params& params, const OnIteration& on_iteration = {},
