@@ -215,7 +215,7 @@ async function submit(e) {
       { also: ['emax'] });
     } else if (err.status === 413)
       file_error(`${name} is too large for this server: ${readable_numbers(err.message)}. Choose a smaller mesh.`);
-    else if (err.status === 503) $('submit-status').textContent = `Server busy (queue full): ${err.message}. Try again shortly.`;
+    else if (err.status === 503) $('submit-status').textContent = `Server busy: ${err.message}.`;
     else if (err.status !== 401) $('submit-status').textContent = `Upload failed: ${err.message}`;
   } finally {
     button.disabled = false;
