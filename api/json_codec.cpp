@@ -2,6 +2,7 @@
 
 #include <cctype>
 #include <charconv>
+#include <algorithm>
 #include <cmath>
 #include <functional>
 #include <limits>
@@ -175,7 +176,8 @@ ParsedParams parse_with(Has has, Parse parse) {
   for (const ParamSpec& spec : param_specs()) {
     if (!has(spec.name)) {
       // With bonds the edge fields are not required: a missing bond field is (below).
-      if (spec.required && !out.bonds) out.errors.push_back({spec.name, "is required"});
+      if (spec.required && !out.bonds)
+        out.errors.push_back({spec.name, "is required (or give bond_min and bond_max, the dual's bond lengths)"});
       continue;
     }
     out.given.emplace_back(spec.name);
@@ -188,13 +190,20 @@ ParsedParams parse_with(Has has, Parse parse) {
     out.errors.push_back({has("bond_min") ? "bond_min" : "bond_max",
                           "give either emin and emax (edge lengths) or bond_min and bond_max (the dual's bond "
                           "lengths), not both"});
-    out.bonds.reset();  // the edge fields stand, checked as given
+    out.bonds.reset();
+    out.interval_unknown = true;
     return out;
   }
   if (!has("bond_min")) out.errors.push_back({"bond_min", "is required with bond_max"});
   if (!has("bond_max")) out.errors.push_back({"bond_max", "is required with bond_min"});
+  out.interval_unknown = !has("bond_min") || !has("bond_max");
   out.params.e_min = edge_for_bond(out.bonds->min);
   out.params.e_max = edge_for_bond(out.bonds->max);
+  // A bond past the largest double / sqrt(3) has no edge length (check() would call it not finite).
+  for (const auto& [name, edge] : {std::pair{"bond_min", out.params.e_min}, std::pair{"bond_max", out.params.e_max}})
+    if (has(name) && !std::isfinite(edge) &&
+        std::none_of(out.errors.begin(), out.errors.end(), [&](const FieldError& e) { return e.field == name; }))
+      out.errors.push_back({name, "is too large: its edges, bond * sqrt(3), are past the largest number"});
   return out;
 }
 

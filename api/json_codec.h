@@ -63,6 +63,9 @@ struct ParsedParams {
   /// emax: params.e_min and e_max then hold the bonds times sqrt(3), and errors about the interval
   /// name the bond fields (validate_params, check_interval_against).
   std::optional<BondInterval> bonds;
+  /// A bond field is missing, or bonds and edges were both given: the interval is unknown, and
+  /// validate_params() adds no range error about it.
+  bool interval_unknown = false;
   std::vector<FieldError> errors;  ///< empty when every field parsed (range checks: check())
   std::vector<std::string> given;  ///< names of the parameters present in the input
   bool ok() const { return errors.empty(); }

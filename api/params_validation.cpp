@@ -36,13 +36,16 @@ std::vector<FieldError> in_bond_terms(std::vector<FieldError> errors) {
 
 std::vector<FieldError> validate_params(ParsedParams& parsed, int max_iterations) {
   std::vector<FieldError> errors = parsed.errors;
-  // The fields already reported, by the engine's names. A bond field's error (unreadable, missing,
-  // given beside emin or emax) is the interval's: no range error about it follows.
+  // The fields already reported, by the engine's names: a bad bond_min is a bad emin, a bad
+  // bond_max a bad emax. A missing one, or one given beside emin or emax, leaves the interval
+  // unknown: no range error about either follows.
   std::set<std::string> bad;
   for (const FieldError& e : errors) {
-    if (e.field == "bond_min" || e.field == "bond_max") bad.insert({"emin", "emax"});
     bad.insert(e.field);
+    if (e.field == "bond_min") bad.insert("emin");
+    if (e.field == "bond_max") bad.insert("emax");
   }
+  if (parsed.interval_unknown) bad.insert({"emin", "emax"});
   if (max_iterations > 0) {
     parsed.params.max_iterations = max_iterations;
     bool given = std::find(parsed.given.begin(), parsed.given.end(), "iterations") != parsed.given.end();

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cctype>
 #include <climits>
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <iostream>
@@ -65,6 +66,25 @@ std::string option_for(std::string field) {
   return "--" + field;
 }
 
+/// An error about a parameter said in the CLI's terms: its field and the interval's fields named in
+/// its message as options ("--bond-max: must be greater than --bond-min").
+FieldError in_cli_terms(FieldError e) {
+  auto boundary = [](char c) { return !std::isalnum(static_cast<unsigned char>(c)) && c != '_' && c != '-'; };
+  for (const char* name : {"bond_min", "bond_max", "emin", "emax"}) {
+    const std::string option = option_for(name);
+    const std::size_t length = std::string_view(name).size();
+    for (std::size_t at = e.message.find(name); at != std::string::npos; at = e.message.find(name, at + 1)) {
+      const bool word = (at == 0 || boundary(e.message[at - 1])) &&
+                        (at + length == e.message.size() || boundary(e.message[at + length]));
+      if (!word) continue;
+      e.message.replace(at, length, option);
+      at += option.size() - 1;
+    }
+  }
+  e.field = option_for(e.field);
+  return e;
+}
+
 struct Job {
   std::string in, out;
   std::optional<std::string> dual_out, stats_out;
@@ -109,6 +129,12 @@ Job parse_job(const std::vector<std::string>& args) {
   Params& p = job.params;
   if (auto v = read([&] { return a.get_double(low); })) p.e_min = job.bonds ? edge_for_bond(*v) : *v;
   if (auto v = read([&] { return a.get_double(high); })) p.e_max = job.bonds ? edge_for_bond(*v) : *v;
+  // A bond past the largest double / sqrt(3) has no edge length (check() would call it not finite).
+  for (const auto& [option, edge] : {std::pair{low, p.e_min}, std::pair{high, p.e_max}})
+    if (job.bonds && a.has(option) && !unreadable.count(std::string("--") + option) && !std::isfinite(edge)) {
+      errors.push_back({std::string("--") + option, "is too large: its edges, bond * sqrt(3), are past the largest number"});
+      unreadable.insert(std::string("--") + option);
+    }
   if (auto v = read([&] { return a.get_int("iterations", INT_MIN, INT_MAX); })) p.iterations = static_cast<int>(*v);
   if (auto v = read([&] { return a.get_int("rings", INT_MIN, INT_MAX); })) p.rings = static_cast<int>(*v);
   if (auto v = read([&] { return a.get_int("relax-every", INT_MIN, INT_MAX); })) p.relax_every = static_cast<int>(*v);
@@ -128,8 +154,8 @@ Job parse_job(const std::vector<std::string>& args) {
   job.dual_out = a.get("dual");
   job.stats_out = a.get("stats");
 
-  for (auto& e : job.bonds ? in_bond_terms(check(p)) : check(p)) {
-    e.field = option_for(e.field);
+  for (const auto& checked : job.bonds ? in_bond_terms(check(p)) : check(p)) {
+    FieldError e = in_cli_terms(checked);
     // An option whose value did not parse kept its default, which check() may refuse too (e_min
     // 0): it has its line already.
     if (!unreadable.count(e.field)) errors.push_back(std::move(e));
@@ -244,7 +270,7 @@ void print_final(const TriMesh& mesh, const Job& job, const Result& result, cons
 int run_remesh(const std::vector<std::string>& args) {
   if (wants_help(args)) {
     std::cout << format_help(
-        "remesh IN OUT --emin A --emax B [OPTIONS]",
+        "remesh IN OUT (--emin A --emax B | --bond-min A --bond-max B) [OPTIONS]",
         "Remeshes IN by iterative edge equalization so that its edge lengths lie in [A, B] and writes\n"
         "OUT (.obj .off .ply .stl .glb .xyz .lammps). Shows the statistics every 5 iterations and a\n"
         "final quality summary. Ctrl-C stops after the current step and still writes the (valid) mesh.\n"
@@ -262,12 +288,12 @@ int run_remesh(const std::vector<std::string>& args) {
   // A mesh the remesher refuses gets its one line before the repairs are listed.
   check_mesh_size(loaded.mesh);
   check_vertex_stars(loaded.mesh);
-  // Before equalize() checks it in edge lengths: said in the bonds given.
-  if (job.bonds)
-    if (auto errors = check_interval_against(loaded.mesh, job.params, true); !errors.empty()) {
-      for (auto& e : errors) e.field = option_for(e.field);
-      throw ParamsError(std::move(errors));
-    }
+  // Before equalize() checks them in the engine's terms: said with the options given.
+  if (auto errors = check_interval_against(loaded.mesh, job.params, job.bonds); !errors.empty()) {
+    for (auto& e : errors) e = in_cli_terms(std::move(e));
+    throw ParamsError(std::move(errors));
+  }
+  if (job.bonds) check_output_estimate(loaded.mesh, job.params, "--bond-max too small for this mesh");
   if (!job.quiet) print_repairs(std::cerr, loaded.repairs);
   std::optional<ReferenceSurface> reference;
   if (job.dual_out) reference.emplace(loaded.mesh);

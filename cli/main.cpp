@@ -29,6 +29,7 @@ std::string one_line(std::string s) {
 const char* const kOverview =
     "Usage: remesh COMMAND [ARGS...]\n"
     "       remesh IN OUT --emin A --emax B [OPTIONS]\n"
+    "       remesh IN OUT --bond-min A --bond-max B [OPTIONS]\n"
     "\n"
     "Iterative edge-length equalization of triangle meshes and their trivalent duals.\n"
     "\n"

@@ -64,9 +64,9 @@ constexpr const char* kPrefix = "/api/v1";
 constexpr std::size_t kMiB = 1024 * 1024;
 /// Uploads from this size on have the memory they took handed back to the system after their answer.
 constexpr std::size_t kTrimAfterBytes = 8 * kMiB;
-/// An upload of this size or more (or of unknown length: chunked) waits for a slot of the upload
-/// gate (upload_gate.h) before it is read; smaller ones, at most about 40 MB each read, go at once.
-constexpr std::size_t kGatedUploadBytes = 4 * kMiB;
+/// An upload of this size or more (its bytes as decoded) waits for a slot of the upload gate
+/// (upload_gate.h) before its mesh is read; smaller ones, about 10 MB each to read, go at once.
+constexpr std::size_t kGatedUploadBytes = 1 * kMiB;
 constexpr std::size_t kMaxParamsBytes = 64 * 1024;
 /// The query keys of POST /jobs that are not job parameters.
 const std::vector<std::string> kUploadQueryKeys = {"format", "filename", "access_token"};
@@ -427,10 +427,11 @@ bool HttpServer::Impl::authorized(const httplib::Request& req) const {
 void HttpServer::Impl::setup() {
   unsigned threads = options.http_threads ? options.http_threads : options.max_streams + 16;
   server.new_task_queue = [threads] { return new httplib::ThreadPool(threads); };
-  // At most a quarter of the HTTP threads wait at the gate, so that the rest still answer (the
-  // page's polls, downloads, health checks).
+  // At most half of the HTTP threads the event streams leave wait at the gate, so that the rest
+  // still answer (the page's polls, downloads, health checks) with every stream open.
   const unsigned slots = options.upload_slots ? options.upload_slots : static_cast<unsigned>(jobs.gauges().workers);
-  upload_gate = std::make_unique<UploadGate>(slots, options.upload_wait_seconds, std::max(1u, threads / 4));
+  const unsigned spare = threads > options.max_streams ? threads - options.max_streams : 0;
+  upload_gate = std::make_unique<UploadGate>(slots, options.upload_wait_seconds, std::max(1u, spare / 2));
   server.set_payload_max_length(options.max_upload_mb * kMiB + kMiB);  // Content-Length; chunked counted below
   // httplib's default also sets SO_REUSEPORT, which lets a second daemon bind the same port.
   server.set_socket_options([](socket_t sock) {
@@ -840,33 +841,6 @@ void HttpServer::Impl::post_job(const httplib::Request& req, httplib::Response& 
       return;
     }
   }
-  // A large upload is read, and its mesh checked, while it holds a slot of the gate (upload_gate.h:
-  // reading a mesh takes about ten times its size for a moment); the answer waits for one.
-  std::optional<UploadGate::Pass> pass;
-  const bool large = req.has_header("Content-Length")
-                         ? std::stoull(req.get_header_value("Content-Length")) >= kGatedUploadBytes
-                         : has_body(req);
-  if (large) {
-    UploadGate::Entry entry = upload_gate->enter();
-    if (!entry.pass) {
-      // The body is read and dropped, up to kDrainBytes, so that a client that sends before it
-      // reads gets the answer rather than a reset (as for a 413).
-      std::size_t drained = 0;
-      auto discard = [&drained](const char*, std::size_t n) { return (drained += n) <= kDrainBytes; };
-      if (req.is_multipart_form_data()) reader([](const httplib::MultipartFormData&) { return true; }, discard);
-      else reader(discard);
-      const bool closed = entry.refusal == UploadGate::Refusal::Closed;
-      res.set_header("Retry-After", closed ? "5" : "10");
-      res.set_header("Connection", "close");
-      send_problem(res, 503,
-                   closed ? std::string("the server is shutting down")
-                          : "the server is reading " + std::to_string(upload_gate->slots()) +
-                                " other large uploads and no slot came free (--upload-slots, --upload-wait-seconds); "
-                                "try again in a few seconds");
-      return;
-    }
-    pass = std::move(entry.pass);
-  }
   // No body ('curl -X POST' without a file got its error after 30 s): nothing to read, and the
   // checks below say what is missing.
   if (!has_body(req)) {
@@ -975,6 +949,24 @@ void HttpServer::Impl::post_job(const httplib::Request& req, httplib::Response& 
     return;
   }
 
+  // A large upload's mesh is read, and checked, while it holds a slot of the gate (upload_gate.h:
+  // reading a mesh takes about ten times its size for a moment); it waits for one. Its bytes are in
+  // already (decoded), so a client sending slowly holds no slot.
+  std::optional<UploadGate::Pass> pass;
+  if (body.size() >= kGatedUploadBytes) {
+    UploadGate::Entry entry = upload_gate->enter();
+    if (!entry.pass) {
+      const bool closed = entry.refusal == UploadGate::Refusal::Closed;
+      res.set_header("Retry-After", closed ? "5" : "10");
+      send_problem(res, 503,
+                   closed ? std::string("the server is shutting down")
+                          : "the server is reading " + std::to_string(upload_gate->slots()) +
+                                " other large uploads and no slot came free (--upload-slots, --upload-wait-seconds); "
+                                "try again in a few seconds");
+      return;
+    }
+    pass = std::move(entry.pass);
+  }
   remesh::api::UploadLimits limits;
   limits.max_faces = options.max_faces;
   limits.max_iterations = options.max_iterations;

@@ -126,7 +126,7 @@ const std::vector<Spec>& specs() {
          if (o.max_streams == 0) throw std::invalid_argument("--max-streams: at least 1");
        }},
       {"upload-slots", "N",
-       "uploads of 4 MiB or more (or of unknown length) read and checked at once; more wait (default: as many as workers)",
+       "uploads of 1 MiB or more turned into meshes at once; more wait (default: as many as workers)",
        [](Options& o, const std::string& v) {
          o.upload_slots = static_cast<unsigned>(to_size("upload-slots", v, kMaxThreads));
        }},

@@ -15,17 +15,22 @@ UploadGate::Entry UploadGate::enter() {
     entry.refusal = Refusal::Closed;
     return entry;
   }
-  if (busy_ >= slots_) {
-    if (waiting_ >= max_waiting_) return entry;
-    ++waiting_;
+  // First come, first served: with others waiting, a newcomer waits behind them even when a slot
+  // is free this moment (one freed for the first of them, who is still waking up).
+  if (busy_ >= slots_ || !line_.empty()) {
+    if (line_.size() >= max_waiting_) return entry;
+    const std::uint64_t ticket = next_ticket_++;
+    line_.push_back(ticket);
     const auto until = std::chrono::steady_clock::now() + std::chrono::duration<double>(wait_seconds_);
-    const bool free = free_.wait_until(lock, until, [&] { return closed_ || busy_ < slots_; });
-    --waiting_;
+    const bool turn = free_.wait_until(lock, until, [&] { return closed_ || (busy_ < slots_ && line_.front() == ticket); });
+    line_.erase(std::find(line_.begin(), line_.end(), ticket));
+    // The next in line may be able to go now (a slot free, or this one leaving the front).
+    free_.notify_all();
     if (closed_) {
       entry.refusal = Refusal::Closed;
       return entry;
     }
-    if (!free) return entry;
+    if (!turn) return entry;
   }
   ++busy_;
   entry.pass.emplace(this);
@@ -37,7 +42,7 @@ void UploadGate::leave() {
     const std::lock_guard lock(mutex_);
     --busy_;
   }
-  free_.notify_one();
+  free_.notify_all();
 }
 
 void UploadGate::close() {
@@ -55,7 +60,7 @@ unsigned UploadGate::busy() const {
 
 unsigned UploadGate::waiting() const {
   const std::lock_guard lock(mutex_);
-  return waiting_;
+  return static_cast<unsigned>(line_.size());
 }
 
 }  // namespace remeshd

@@ -1,14 +1,18 @@
 #pragma once
 /// \file upload_gate.h
-/// Large uploads are read and checked a few at a time. Reading a mesh takes about ten times its
-/// file's size in memory for a moment (its bytes, the polygons read, the half-edge mesh, the search
-/// for faces crossing each other: a 36 MB OBJ of 977 000 faces about 360 MB), and each upload is
-/// read on its own HTTP thread: eight such uploads at once took the daemon to 2.9 GB, and the 80
-/// HTTP threads could take it past a machine's memory, where the kernel kills it. Reading more at
-/// once than there are cores gains no time either (those eight took 27 s each, side by side).
+/// Large uploads are turned into meshes a few at a time. Reading a mesh takes about ten times its
+/// file's size in memory for a moment (the polygons read, the half-edge mesh, the search for faces
+/// crossing each other: a 36 MB OBJ of 977 000 faces about 360 MB), and each upload is read on its
+/// own HTTP thread: eight such uploads at once took the daemon to 2.9 GB, and the 80 HTTP threads
+/// could take it past a machine's memory, where the kernel kills it. Reading more at once than
+/// there are cores gains no time either (those eight took 27 s each, side by side). A slot is
+/// taken once the upload's bytes are in (a client sending slowly holds none), and waiters go in
+/// the order they came.
 
 #include <condition_variable>
 #include <cstddef>
+#include <cstdint>
+#include <deque>
 #include <mutex>
 #include <optional>
 
@@ -16,8 +20,8 @@ namespace remeshd {
 
 class UploadGate {
  public:
-  /// `slots` uploads pass at once (at least 1); one more waits up to `wait_seconds` for a slot, while
-  /// fewer than `max_waiting` wait already.
+  /// `slots` uploads pass at once (at least 1); one more waits up to `wait_seconds` for its turn,
+  /// while fewer than `max_waiting` wait already (else it is refused at once).
   UploadGate(unsigned slots, double wait_seconds, unsigned max_waiting);
 
   /// A slot, held until destroyed.
@@ -67,7 +71,9 @@ class UploadGate {
   const unsigned max_waiting_;
   mutable std::mutex mutex_;
   std::condition_variable free_;
-  unsigned busy_ = 0, waiting_ = 0;
+  unsigned busy_ = 0;
+  std::deque<std::uint64_t> line_;  ///< tickets of the waiters, first come first
+  std::uint64_t next_ticket_ = 0;
   bool closed_ = false;
 };
 

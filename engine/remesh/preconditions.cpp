@@ -75,19 +75,23 @@ std::size_t estimate_output_faces(const TriMesh& mesh, const Params& params) {
 }
 
 
-void check_preconditions(const TriMesh& mesh, const Params& params) {
-  if (auto errors = check(params); !errors.empty()) throw ParamsError(std::move(errors));
-  if (mesh.n_faces() == 0) throw MeshError("the mesh has no faces");
-  check_mesh_size(mesh);
-  check_vertex_stars(mesh);
-  if (auto errors = check_against(mesh, params); !errors.empty()) throw ParamsError(std::move(errors));
+void check_output_estimate(const TriMesh& mesh, const Params& params, std::string_view why) {
   const std::size_t estimate = estimate_output_faces(mesh, params);
   // The estimate stops at kMaxFaceEstimate: said as "over" that (it printed 1000000000000000000 as
   // if counted).
   if (params.max_output_faces > 0 && estimate > params.max_output_faces)
     throw LimitError("estimated output of " + std::string(estimate >= kMaxFaceEstimate ? "over " : "") +
                      std::to_string(estimate) + " faces exceeds the limit of " +
-                     std::to_string(params.max_output_faces) + " faces (e_max too small for this mesh)");
+                     std::to_string(params.max_output_faces) + " faces (" + std::string(why) + ")");
+}
+
+void check_preconditions(const TriMesh& mesh, const Params& params) {
+  if (auto errors = check(params); !errors.empty()) throw ParamsError(std::move(errors));
+  if (mesh.n_faces() == 0) throw MeshError("the mesh has no faces");
+  check_mesh_size(mesh);
+  check_vertex_stars(mesh);
+  if (auto errors = check_against(mesh, params); !errors.empty()) throw ParamsError(std::move(errors));
+  check_output_estimate(mesh, params, "e_max too small for this mesh");
 }
 
 }  // namespace remesh

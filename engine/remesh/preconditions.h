@@ -6,6 +6,7 @@
 /// the CLI call the same checks before they queue or start a run.
 
 #include <cstddef>
+#include <string_view>
 #include <vector>
 
 #include "core/errors.h"
@@ -49,6 +50,10 @@ void check_vertex_stars(const TriMesh& mesh);
 /// bounding-box diagonal, since no edge between two points of its surface is longer (no edge could
 /// end inside the interval). Every invalid field, named as check() names them; empty when valid.
 std::vector<FieldError> check_against(const TriMesh& mesh, const Params& params);
+
+/// Throws LimitError, with the estimate, when estimate_output_faces() exceeds
+/// params.max_output_faces (0 = no limit); the message ends with `why` in brackets.
+void check_output_estimate(const TriMesh& mesh, const Params& params, std::string_view why);
 
 /// Every check equalize() makes before it starts: check(params), a mesh with faces,
 /// check_mesh_size, check_vertex_stars, check_against, and the estimated output against

@@ -157,6 +157,10 @@ TEST_CASE("bond_min and bond_max give the interval as the dual's bonds", "[api][
       {{{"bond_min", "x"}, {"bond_max", 1}}, {"bond_min"}, "finite number"},
       {{{"bond_min", "x"}, {"rings", 9}}, {"bond_min", "bond_max", "rings"}, "finite number"},
       {{{"bond_min", 1}, {"bond_max", 2}, {"rings", 0}}, {"rings"}, "1..4"},
+      // Each bad bond named, as emin and emax are (a bad bond_min hid bond_max's error).
+      {{{"bond_min", "abc"}, {"bond_max", -1}}, {"bond_min", "bond_max"}, "finite number"},
+      {{{"bond_min", 1}, {"bond_max", 1.5e308}}, {"bond_max"}, "too large"},
+      {{{"emin", 1}}, {"emax"}, "or give bond_min and bond_max"},
   };
   for (const Row& row : rows) {
     INFO(row.doc.dump());

@@ -163,10 +163,12 @@ TEST_CASE("bad arguments exit with 2 and one line on stderr", "[cli]") {
   // The interval as the dual's bonds: each mistake named by the options given.
   cases.push_back({{mesh, out, "--bond-min", "0.1"}, "missing required option --bond-max"});
   cases.push_back({{mesh, out, "--bond-min", "0.1", "--bond-max", "0.2", "--emin", "0.2"}, "not both"});
-  cases.push_back({{mesh, out, "--bond-min", "0.2", "--bond-max", "0.1"}, "--bond-max: must be greater than bond_min"});
+  cases.push_back({{mesh, out, "--bond-min", "0.2", "--bond-max", "0.1"}, "--bond-max: must be greater than --bond-min"});
   cases.push_back({{mesh, out, "--bond-min", "x", "--bond-max", "0.1"}, "--bond-min: 'x' is not a number"});
   // The icosphere's bounding-box diagonal is 2 sqrt(3): edges of at least 2 * sqrt(3) (bonds of 2) cannot fit.
   cases.push_back({{mesh, out, "--bond-min", "2.5", "--bond-max", "3"}, "--bond-min: must be shorter than 2,"});
+  cases.push_back({{mesh, out, "--emin", "4", "--emax", "5"}, "--emin: must be shorter than"});
+  cases.push_back({{mesh, out, "--bond-min", "1", "--bond-max", "1.5e308"}, "--bond-max: is too large"});
   // A name longer than the file system takes (a long one it takes is written: the probe was
   // named after it, and too long itself).
   cases.push_back({{"convert", mesh, dir.file(std::string(300, 'a') + ".obj")}, "output file name too long"});
@@ -695,6 +697,11 @@ TEST_CASE("a job over --max-faces is refused with exit 3", "[cli]") {
   r = remesh_cli({dir.file("sphere.obj"), dir.file("out.obj"), "--emin", "1e-300", "--emax", "2e-300"});
   CHECK(r.exit_code == 3);
   CHECK(r.err.find("estimated output of over 1000000000000000000 faces") != std::string::npos);
+  // Given as bonds, the advice names the option given.
+  r = remesh_cli({dir.file("sphere.obj"), dir.file("out.obj"), "--bond-min", "0.0001", "--bond-max", "0.0002"});
+  CHECK(r.exit_code == 3);
+  CHECK(lines(r.err) == 1);
+  CHECK(r.err.find("(--bond-max too small for this mesh)") != std::string::npos);
 }
 
 TEST_CASE("output piped into a program that exits early does not stop the run", "[cli]") {

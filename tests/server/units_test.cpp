@@ -3,6 +3,7 @@
 
 #include <chrono>
 #include <cstdlib>
+#include <atomic>
 #include <future>
 #include <optional>
 #include <thread>
@@ -299,6 +300,26 @@ TEST_CASE("UploadGate: slots, a bounded wait, a bounded line, and close", "[serv
   gate.close();
   CHECK(woken.get() == UploadGate::Refusal::Closed);
   CHECK(gate.enter().refusal == UploadGate::Refusal::Closed);
+  // First come, first served: a slot freed while one waits is that waiter's, not a newcomer's.
+  UploadGate fair(1, 5, 4);
+  UploadGate::Entry holding = fair.enter();
+  REQUIRE(holding.pass);
+  std::atomic<int> order{0};
+  int waiter_turn = -1, newcomer_turn = -1;
+  auto first_in_line = std::async(std::launch::async, [&] {
+    UploadGate::Entry e = fair.enter();
+    waiter_turn = order++;
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    return e.pass.has_value();
+  });
+  while (fair.waiting() == 0) std::this_thread::yield();
+  holding.pass.reset();
+  UploadGate::Entry newcomer = fair.enter();  // the moment the slot frees
+  newcomer_turn = order++;
+  CHECK(first_in_line.get());
+  CHECK(newcomer.pass);
+  CHECK(waiter_turn == 0);
+  CHECK(newcomer_turn == 1);
   // Moving a pass moves the slot: released once.
   UploadGate two(2, 0, 4);
   UploadGate::Entry a = two.enter();
