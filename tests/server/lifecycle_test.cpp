@@ -88,9 +88,9 @@ TEST_CASE("remeshd: a cancel after the run's last iteration, while its results a
           "[server][cancel]") {
   // After its last row the run makes and writes its results (327 680 faces: the remeshed mesh and
   // its dual in every format), with no more checks for a stop. A DELETE then was answered
-  // `cancelling` and the job ended `succeeded` (a service QA finding). With 81 920 faces the time
-  // between the row and the end (0.85 s) was once too short for the 20 ms poll under a loaded
-  // machine's ctest -j2: the job had ended when the poll saw its row.
+  // `cancelling` and the job ended `succeeded` (a service QA finding). With 81 920 faces (0.85 s
+  // between the row and the end) it failed once under a loaded machine's ctest -j2, most likely
+  // because the 20 ms poll saw the row only after the job had ended.
   TempDir tmp;
   Daemon d(tmp.path / "data", {"--workers", "1"});
   auto c = d.client();
