@@ -1,8 +1,8 @@
 #include "json_codec.h"
 
+#include <algorithm>
 #include <cctype>
 #include <charconv>
-#include <algorithm>
 #include <cmath>
 #include <functional>
 #include <limits>
