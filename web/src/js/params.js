@@ -148,7 +148,7 @@ export function show_bonds() {
 
 /// The helper: target mean ± tolerance % -> emin/emax. `on_change` runs after the form changed.
 /// A wrong target or tolerance is named beside the helper instead of being replaced by a default.
-/// The target is an edge length or, with "dual bond" chosen, a bond length of the dual.
+/// The target is an edge length or, with "bond" chosen beside it, a bond length of the dual.
 export function init_helper(on_change) {
   clear_on_edit();
   decimal_comma();
