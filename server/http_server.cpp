@@ -539,6 +539,8 @@ void HttpServer::Impl::setup() {
   get("/metrics", guard([this](const auto&, auto& res) {
         Gauges g = jobs.gauges();
         g.open_streams = streams.load();
+        g.uploads_reading = upload_gate->busy();
+        g.uploads_waiting = upload_gate->waiting();
         res.set_content(metrics.render(g), "text/plain; version=0.0.4; charset=utf-8");
       }));
   get(std::string(kPrefix) + "/openapi\\.yaml", guard([](const auto& req, auto& res) {

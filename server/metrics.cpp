@@ -76,6 +76,11 @@ std::string Metrics::render(const Gauges& g) {
   o += "remeshd_workers " + std::to_string(g.workers) + "\n";
   o += "# HELP remeshd_event_streams Open event streams.\n# TYPE remeshd_event_streams gauge\n";
   o += "remeshd_event_streams " + std::to_string(g.open_streams) + "\n";
+  o += "# HELP remeshd_uploads_reading Large uploads being read into meshes (a slot of --upload-slots each).\n"
+       "# TYPE remeshd_uploads_reading gauge\n";
+  o += "remeshd_uploads_reading " + std::to_string(g.uploads_reading) + "\n";
+  o += "# HELP remeshd_uploads_waiting Large uploads waiting for a slot.\n# TYPE remeshd_uploads_waiting gauge\n";
+  o += "remeshd_uploads_waiting " + std::to_string(g.uploads_waiting) + "\n";
 
   std::lock_guard lock(mutex_);
   double now = steady_now();

@@ -19,6 +19,8 @@ struct Gauges {
   std::size_t busy_workers = 0;
   std::size_t workers = 0;
   std::size_t open_streams = 0;
+  std::size_t uploads_reading = 0;  ///< large uploads holding a slot of the upload gate
+  std::size_t uploads_waiting = 0;  ///< and waiting for one
 };
 
 class Metrics {

@@ -256,6 +256,9 @@ TEST_CASE("remeshd: large uploads are read a few at a time, one that finds no sl
     auto refused = submit_raw(c, large, "emin=0.2&emax=0.35&iterations=1");
     auto too_big = submit_raw(c, over, "emin=0.2&emax=0.35&iterations=1");
     const bool held = uploads()["reading"] == 1;  // still reading the slow one after both answers
+    auto metrics = c.Get("/metrics");
+    REQUIRE(metrics);
+    const bool metered = metrics->body.find("\nremeshd_uploads_reading 1\n") != std::string::npos;
     holder.join();
     REQUIRE(first);
     REQUIRE(*first);
@@ -265,6 +268,7 @@ TEST_CASE("remeshd: large uploads are read a few at a time, one that finds no sl
     CHECK(too_big->status == 413);  // the limit, never the gate's 503
     if (!held) continue;
     seen = true;
+    CHECK(metered);
     CHECK(refused->status == 503);
     CHECK(refused->get_header_value("Retry-After") == "10");
     CHECK(refused->body.find("--upload-slots") != std::string::npos);
@@ -278,6 +282,10 @@ TEST_CASE("remeshd: large uploads are read a few at a time, one that finds no sl
   REQUIRE(accepted);
   CHECK(accepted->status == 202);
   CHECK(uploads() == json{{"reading", 0}, {"waiting", 0}, {"slots", 1}});
+  auto metrics = c.Get("/metrics");
+  REQUIRE(metrics);
+  CHECK(metrics->body.find("\nremeshd_uploads_reading 0\n") != std::string::npos);
+  CHECK(metrics->body.find("\nremeshd_uploads_waiting 0\n") != std::string::npos);
 }
 
 TEST_CASE("remeshd: static files from the web root, safely", "[server][static]") {
