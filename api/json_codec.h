@@ -12,6 +12,7 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -95,6 +96,14 @@ std::vector<FieldError> validate_params(ParsedParams& parsed, int max_iterations
 /// in bond lengths when the interval was given so (`bonds`): field bond_min, the bound divided by
 /// sqrt(3).
 std::vector<FieldError> check_interval_against(const TriMesh& mesh, const Params& params, bool bonds);
+
+/// A parameter's name and the name it is given instead (renamed()).
+using Rename = std::pair<std::string_view, std::string_view>;
+
+/// `errors` with parameters named otherwise: each field named `first` becomes `second`, and so does
+/// each whole word `first` in the messages (not "emin" within "bond_emin"). For the bond fields, the
+/// CLI's options, ...
+std::vector<FieldError> renamed(std::vector<FieldError> errors, const std::vector<Rename>& names);
 
 /// Errors about emin and emax said as the bond fields gave them: the fields emin and emax become
 /// bond_min and bond_max, in the field names and in the messages ("must be greater than bond_min").

@@ -1,4 +1,5 @@
 #include <algorithm>
+#include <cctype>
 #include <cstdio>
 #include <set>
 
@@ -7,31 +8,34 @@
 
 namespace remesh {
 
-namespace {
-
-/// The bond field an edge field stands for ("emin" -> "bond_min"); other names as they are.
-std::string bond_field(const std::string& field) {
-  if (field == "emin") return "bond_min";
-  if (field == "emax") return "bond_max";
-  return field;
-}
-
-/// `text` with the words emin and emax said as bond_min and bond_max.
-std::string bond_words(std::string text) {
-  for (const auto& [edge, bond] : {std::pair<std::string, std::string>{"emin", "bond_min"}, {"emax", "bond_max"}})
-    for (std::size_t at = text.find(edge); at != std::string::npos; at = text.find(edge, at + bond.size()))
-      text.replace(at, edge.size(), bond);
-  return text;
-}
-
-}  // namespace
-
-std::vector<FieldError> in_bond_terms(std::vector<FieldError> errors) {
+std::vector<FieldError> renamed(std::vector<FieldError> errors, const std::vector<Rename>& names) {
+  // A name counts as a word between characters that cannot be part of a parameter's name.
+  auto boundary = [](char c) { return !std::isalnum(static_cast<unsigned char>(c)) && c != '_' && c != '-'; };
   for (FieldError& e : errors) {
-    e.field = bond_field(e.field);
-    e.message = bond_words(std::move(e.message));
+    if (const auto name = std::find_if(names.begin(), names.end(), [&](const Rename& n) { return e.field == n.first; });
+        name != names.end())
+      e.field = name->second;
+    std::string out;
+    const std::string& text = e.message;
+    for (std::size_t at = 0; at < text.size();) {
+      const auto name = std::find_if(names.begin(), names.end(), [&](const Rename& n) {
+        return text.compare(at, n.first.size(), n.first) == 0 && (at == 0 || boundary(text[at - 1])) &&
+               (at + n.first.size() == text.size() || boundary(text[at + n.first.size()]));
+      });
+      if (name == names.end()) {
+        out += text[at++];
+      } else {
+        out += name->second;
+        at += name->first.size();
+      }
+    }
+    e.message = std::move(out);
   }
   return errors;
+}
+
+std::vector<FieldError> in_bond_terms(std::vector<FieldError> errors) {
+  return renamed(std::move(errors), {{"emin", "bond_min"}, {"emax", "bond_max"}});
 }
 
 std::vector<FieldError> validate_params(ParsedParams& parsed, int max_iterations) {

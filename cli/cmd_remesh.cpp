@@ -66,22 +66,12 @@ std::string option_for(std::string field) {
   return "--" + field;
 }
 
-/// An error about a parameter said in the CLI's terms: its field and the interval's fields named in
-/// its message as options ("--bond-max: must be greater than --bond-min").
+/// An error about a parameter said in the CLI's terms: its field, and the interval's fields named in
+/// its message, as options ("--bond-max: must be greater than --bond-min").
 FieldError in_cli_terms(FieldError e) {
-  auto boundary = [](char c) { return !std::isalnum(static_cast<unsigned char>(c)) && c != '_' && c != '-'; };
-  for (const char* name : {"bond_min", "bond_max", "emin", "emax"}) {
-    const std::string option = option_for(name);
-    const std::size_t length = std::string_view(name).size();
-    for (std::size_t at = e.message.find(name); at != std::string::npos; at = e.message.find(name, at + 1)) {
-      const bool word = (at == 0 || boundary(e.message[at - 1])) &&
-                        (at + length == e.message.size() || boundary(e.message[at + length]));
-      if (!word) continue;
-      e.message.replace(at, length, option);
-      at += option.size() - 1;
-    }
-  }
-  e.field = option_for(e.field);
+  e = renamed({std::move(e)}, {{"bond_min", "--bond-min"}, {"bond_max", "--bond-max"}, {"emin", "--emin"}, {"emax", "--emax"}})
+          .front();
+  if (!e.field.starts_with("--")) e.field = option_for(e.field);
   return e;
 }
 

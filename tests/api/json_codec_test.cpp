@@ -175,6 +175,10 @@ TEST_CASE("bond_min and bond_max give the interval as the dual's bonds", "[api][
   CHECK(said[0].field == "bond_max");
   CHECK(said[0].message == "must be greater than bond_min");
   CHECK(said[1].field == "rings");
+  // Whole words only, in one pass (a new name is not renamed again).
+  const auto words = renamed({{"emin", "emin, emin_x, x_emin, --emin and emax"}}, {{"emin", "emax"}, {"emax", "E"}});
+  CHECK(words[0].field == "emax");
+  CHECK(words[0].message == "emax, emin_x, x_emin, --emin and E");
 }
 
 TEST_CASE("Params and summaries map to the documented JSON names", "[api][json]") {
