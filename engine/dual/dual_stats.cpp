@@ -2,9 +2,20 @@
 
 #include <algorithm>
 #include <cmath>
+#include <charconv>
 #include <limits>
 
 namespace remesh {
+
+double bond_for_edge(double edge) {
+  const double bond = edge / std::sqrt(3.0);
+  if (!std::isfinite(bond)) return bond;
+  char text[32];
+  const auto written = std::to_chars(text, text + sizeof text, bond, std::chars_format::general, 15);
+  double rounded = bond;
+  std::from_chars(text, written.ptr, rounded);
+  return rounded;
+}
 
 DualStats dual_stats(const PolyMesh& dual, double e_min, double e_max) {
   DualStats s;

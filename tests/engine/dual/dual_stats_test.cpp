@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -76,8 +77,9 @@ TEST_CASE("dual_stats' bond lengths equal a recomputation, and the interval is t
     CHECK(s.deviation == Approx(std::sqrt(var)).epsilon(1e-9));
     CHECK(s.min == lengths.front());
     CHECK(s.max == lengths.back());
-    CHECK(s.bond_min == Approx(lo).epsilon(1e-15));
-    CHECK(s.bond_max == Approx(hi).epsilon(1e-15));
+    // To 15 significant digits (bond_for_edge).
+    CHECK(s.bond_min == Approx(lo).epsilon(1e-14));
+    CHECK(s.bond_max == Approx(hi).epsilon(1e-14));
     const auto below = std::count_if(lengths.begin(), lengths.end(), [&](double l) { return l < s.bond_min; });
     const auto above = std::count_if(lengths.begin(), lengths.end(), [&](double l) { return l > s.bond_max; });
     CHECK(s.short_bonds == static_cast<std::size_t>(below));
@@ -106,4 +108,25 @@ TEST_CASE("dual_stats: equilateral triangles of side a have bonds of a / sqrt(3)
   const DualStats above = dual_stats(trivalent_dual(lattice), 1.5 * 1.01, 1.5 * 1.1);
   CHECK(above.short_bonds == above.bonds);
   CHECK(above.inside_fraction() == 0.0);
+}
+
+TEST_CASE("bond_for_edge gives back the bond that edge_for_bond was given", "[dual]") {
+  // Bonds as users type them (carbon's 1.42 angstrom +- 10 %, boron nitride's 1.45, ...): each
+  // comes back exactly, so the job's dual.bond_interval reads as given. Plain division by sqrt(3)
+  // gave 1.2779999999999998 for 1.278.
+  int plain_misses = 0;
+  for (double bond : {1.278, 1.562, 1.42, 1.45, 1.3, 1.5, 0.1, 0.35, 2.5, 3.1415926535, 123.456, 1e-3, 7e5}) {
+    INFO(bond);
+    CHECK(bond_for_edge(edge_for_bond(bond)) == bond);
+    plain_misses += edge_for_bond(bond) / std::sqrt(3.0) != bond;
+  }
+  CHECK(plain_misses > 0);  // the case this guards against occurs among them
+  // Any other value moves by at most 5e-15 of itself; non-finite and zero pass through.
+  for (double edge : {1.0, 2.0 / 3.0, std::sqrt(2.0), 1e-300, 1e300, 0.0}) {
+    INFO(edge);
+    const double exact = edge / std::sqrt(3.0);
+    CHECK(std::abs(bond_for_edge(edge) - exact) <= 5e-15 * exact);
+  }
+  CHECK(std::isinf(bond_for_edge(std::numeric_limits<double>::infinity())));
+  CHECK(std::isnan(bond_for_edge(std::nan(""))));
 }
