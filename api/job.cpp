@@ -53,9 +53,12 @@ std::optional<double> opt_time(const json& j, const char* key) {
 json format_links(const std::string& base, const std::string& mesh, const std::vector<std::string>& formats,
                   const std::vector<std::string>& unwritable) {
   json links = json::object();
+  auto cannot = [&](const std::string& f) {
+    return std::find(unwritable.begin(), unwritable.end(), mesh + "." + f) != unwritable.end();
+  };
+  // Text glTF stores float32 as GLB does: a mesh GLB cannot hold, it cannot either.
   for (const std::string& f : formats)
-    if (std::find(unwritable.begin(), unwritable.end(), mesh + "." + f) == unwritable.end())
-      links[f] = base + "/result?mesh=" + mesh + "&format=" + f;
+    if (!cannot(f) && !(f == "gltf" && cannot("glb"))) links[f] = base + "/result?mesh=" + mesh + "&format=" + f;
   return links;
 }
 
@@ -166,14 +169,16 @@ std::string iso8601(double unix_seconds) {
 std::string_view outcome_name(Outcome o) { return remesh::outcome_name(o); }
 
 const std::vector<std::string>& remeshed_formats() {
-  static const std::vector<std::string> f = {"obj", "glb", "ply", "off", "stl", "lammps"};
+  static const std::vector<std::string> f = {"obj", "glb", "gltf", "ply", "off", "stl", "lammps"};
   return f;
 }
 
 const std::vector<std::string>& dual_formats() {
-  static const std::vector<std::string> f = {"obj", "glb", "ply", "off", "xyz", "lammps"};
+  static const std::vector<std::string> f = {"obj", "glb", "gltf", "ply", "off", "xyz", "lammps"};
   return f;
 }
+
+bool made_on_request(std::string_view format) { return format == "gltf"; }
 
 json job_to_json(const JobRecord& job, std::string_view prefix, double now) {
   const std::string base = std::string(prefix) + "/jobs/" + job.id;

@@ -95,8 +95,11 @@ JobRecord job_from_json(const nlohmann::json& j);
 std::string_view outcome_name(Outcome o);
 
 /// Result kinds and the formats each can be downloaded in.
-const std::vector<std::string>& remeshed_formats();  ///< obj, glb, ply, off, stl, lammps
-const std::vector<std::string>& dual_formats();      ///< obj, glb, ply, off, xyz, lammps
+const std::vector<std::string>& remeshed_formats();  ///< obj, glb, gltf, ply, off, stl, lammps
+const std::vector<std::string>& dual_formats();      ///< obj, glb, gltf, ply, off, xyz, lammps
+/// A format made from the job's OBJ on its first download instead of written when the job ends:
+/// text glTF ("gltf"), the GLB's document with its buffer in base64, a third larger than the GLB.
+bool made_on_request(std::string_view format);
 
 /// A fresh job id: 128 random bits from std::random_device as 32 lowercase hex characters.
 std::string new_job_id();

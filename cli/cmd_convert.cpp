@@ -21,9 +21,9 @@ int run_convert(const std::vector<std::string>& args) {
     std::cout << format_help("remesh convert IN OUT [--weld]",
                              "Reads IN (obj, off, ply, stl, gltf, glb), repairs it as 'remesh info' reports,\n"
                              "and writes OUT in the format of its extension: .obj, .off, .ply (binary),\n"
-                             ".stl (binary), .glb (binary glTF), .xyz (one atom per vertex) or .lammps\n"
-                             "(.lmp, .data: a LAMMPS data file, an atom per vertex and a bond per edge).\n"
-                             "Text .gltf is not written: use .glb.",
+                             ".stl (binary), .glb (binary glTF), .gltf (text glTF, its buffer inside as\n"
+                             "base64), .xyz (one atom per vertex) or .lammps (.lmp, .data: a LAMMPS data\n"
+                             "file, an atom per vertex and a bond per edge).",
                              kSpec);
     return 0;
   }

@@ -23,8 +23,8 @@ int run_dual(const std::vector<std::string>& args) {
     std::cout << format_help("remesh dual IN OUT [--weld]",
                              "Writes the trivalent dual of IN: one vertex per triangle (its centroid), one\n"
                              "polygon per interior vertex, oriented like IN; boundary vertices give no face.\n"
-                             "OUT by extension: .obj/.off/.ply (polygons), .glb (triangle fans plus a LINES\n"
-                             "primitive of the polygon edges), .stl (fans), .xyz (one carbon atom per vertex),\n"
+                             "OUT by extension: .obj/.off/.ply (polygons), .glb/.gltf (triangle fans plus a\n"
+                             "LINES primitive of the polygon edges), .stl (fans), .xyz (one carbon atom per vertex),\n"
                              ".lammps/.lmp/.data (LAMMPS data file: a carbon atom per vertex, a bond per edge).",
                              kSpec);
     return 0;

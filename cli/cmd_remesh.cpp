@@ -262,7 +262,7 @@ int run_remesh(const std::vector<std::string>& args) {
     std::cout << format_help(
         "remesh IN OUT (--emin A --emax B | --bond-min A --bond-max B) [OPTIONS]",
         "Remeshes IN by iterative edge equalization so that its edge lengths lie in [A, B] and writes\n"
-        "OUT (.obj .off .ply .stl .glb .xyz .lammps). Shows the statistics every 5 iterations and a\n"
+        "OUT (.obj .off .ply .stl .glb .gltf .xyz .lammps). Shows the statistics every 5 iterations and a\n"
         "final quality summary. Ctrl-C stops after the current step and still writes the (valid) mesh.\n"
         "For dual edges (bond lengths) in [a, b], give --bond-min a --bond-max b instead: the primal\n"
         "interval is then [a*sqrt(3), b*sqrt(3)].",

@@ -23,8 +23,8 @@ int run_remesh(const std::vector<std::string>& args);
 
 /// Throws UsageError unless `path` names an existing regular file.
 void require_input_file(const std::string& path);
-/// The format to write `path` in, from its extension. Throws UsageError for an unknown extension
-/// and for .gltf (only the binary .glb is written), and when the directory of `path` does not exist.
+/// The format to write `path` in, from its extension. Throws UsageError for an unknown extension,
+/// and when the directory of `path` does not exist.
 Format require_output_format(const std::string& path);
 /// Throws UsageError unless a file can be written at `path`: its directory exists and takes a new
 /// file, and `path` is no directory.

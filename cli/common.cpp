@@ -26,10 +26,7 @@ Format require_output_format(const std::string& path) {
   auto format = parse_format(path);
   if (!format)
     throw UsageError("cannot tell the output format from '" + path +
-                     "' (use .obj, .off, .ply, .stl, .glb, .xyz or .lammps)");
-  if (*format == Format::Gltf)
-    throw UsageError("writing text glTF is not supported: name the output .glb (binary glTF) instead of '" +
-                     path + "'");
+                     "' (use .obj, .off, .ply, .stl, .glb, .gltf, .xyz or .lammps)");
   require_writable(path);
   return *format;
 }

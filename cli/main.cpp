@@ -36,7 +36,7 @@ const char* const kOverview =
     "Commands:\n"
     "  IN OUT --emin A --emax B   remesh IN so its edges lie in [A, B], write OUT ('remesh help remesh')\n"
     "  info MESH                  print the summary of a mesh and the repairs made while reading it\n"
-    "  convert IN OUT             convert between formats (by extension: obj off ply stl glb xyz lammps)\n"
+    "  convert IN OUT             convert between formats (by extension: obj off ply stl glb gltf xyz lammps)\n"
     "  dual IN OUT                write the trivalent dual of a mesh\n"
     "  help [COMMAND]             show help for a command\n"
     "\n"

@@ -57,6 +57,7 @@ RunOutput run_job(const remesh::api::JobRecord& job, std::string upload, unsigne
   // with the others.
   auto write_each = [&](const std::string& stem, const auto& m, const std::vector<std::string>& formats) {
     for (const std::string& f : formats) {
+      if (remesh::api::made_on_request(f)) continue;
       std::string bytes;
       try {
         bytes = remesh::write_mesh(m, format_of(f));

@@ -1,8 +1,8 @@
 /// \file write_glb.cpp
-/// GLB writer (the container is built here; tinygltf is only used for reading). One buffer with
-/// 4-byte aligned views: float32 POSITION (with min/max), UNSIGNED_INT triangle indices (faces
-/// fan-triangulated) and, when any face is not a triangle, a LINES primitive sharing POSITION
-/// that carries every polygon edge once.
+/// glTF 2.0 writers: GLB, and text .gltf with its buffer in a data: URI (the document is built
+/// here; tinygltf reads, and encodes the base64). One buffer with 4-byte aligned views: float32
+/// POSITION (with min/max), UNSIGNED_INT triangle indices (faces fan-triangulated) and, when any
+/// face is not a triangle, a LINES primitive sharing POSITION that carries every polygon edge once.
 
 #include <algorithm>
 #include <cstring>
@@ -40,17 +40,16 @@ std::string number(double v) {
   return s;
 }
 
-}  // namespace
-
-std::string write_glb(const PolygonSoup& soup) {
-  check_float32(soup, "GLB");
+/// The glTF JSON document of `soup` and its binary buffer (`bin`, unpadded). With `embed`, the
+/// buffer is in the document as a base64 data: URI (text .gltf); without, it is the GLB's BIN chunk.
+std::string gltf_document(const PolygonSoup& soup, std::string& bin, bool embed) {
   std::vector<std::uint32_t> tris;
   for_each_fan_triangle(soup, [&](std::uint32_t a, std::uint32_t b, std::uint32_t c) { tris.insert(tris.end(), {a, b, c}); });
   bool polygons = false;
   for (std::size_t f = 0; f + 1 < soup.offsets.size(); ++f) polygons |= soup.offsets[f + 1] - soup.offsets[f] != 3;
   const std::vector<std::uint32_t> lines = polygons ? polygon_edges(soup) : std::vector<std::uint32_t>{};
 
-  std::string bin;
+  bin.clear();
   float lo[3] = {std::numeric_limits<float>::max(), std::numeric_limits<float>::max(), std::numeric_limits<float>::max()};
   float hi[3] = {-lo[0], -lo[1], -lo[2]};
   for (const Vec3& p : soup.points)
@@ -88,8 +87,25 @@ std::string write_glb(const PolygonSoup& soup) {
     if (!tris.empty()) add(tri_offset, tris.size(), 4);
     if (!lines.empty()) add(line_offset, lines.size(), 1);
     json += prims + R"(]}],"accessors":[)" + accessors + R"(],"bufferViews":[)" + views + "],";
-    json += R"("buffers":[{"byteLength":)" + std::to_string(bin.size()) + "}]}";
+    json += R"("buffers":[{"byteLength":)" + std::to_string(bin.size());
+    if (embed) json += R"(,"uri":"data:application/octet-stream;base64,)" + base64(bin) + '"';
+    json += "}]}";
   }
+  return json;
+}
+
+}  // namespace
+
+std::string write_gltf(const PolygonSoup& soup) {
+  check_float32(soup, "glTF");
+  std::string bin;
+  return gltf_document(soup, bin, /*embed=*/true) + "\n";
+}
+
+std::string write_glb(const PolygonSoup& soup) {
+  check_float32(soup, "GLB");
+  std::string bin;
+  std::string json = gltf_document(soup, bin, /*embed=*/false);
   while (json.size() % 4) json += ' ';
   while (bin.size() % 4) bin += '\0';
   const bool has_bin = !bin.empty();

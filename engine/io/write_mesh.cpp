@@ -42,7 +42,7 @@ std::string write_mesh(const PolygonSoup& soup, Format format) {
     case Format::Off: return io::write_off(soup);
     case Format::Ply: return io::write_ply(soup);
     case Format::Stl: return io::write_stl(soup);
-    case Format::Gltf:
+    case Format::Gltf: return io::write_gltf(soup);
     case Format::Glb: return io::write_glb(soup);
     case Format::Xyz: return io::write_xyz(soup);
     case Format::Lammps: return io::write_lammps(soup);
@@ -56,7 +56,7 @@ std::string write_mesh(const PolyMesh& mesh, Format format) { return write_mesh(
 void write_mesh_file(const PolygonSoup& soup, const std::string& path) {
   const std::optional<Format> format = parse_format(path);
   if (!format)
-    throw MeshError("cannot tell the output format from '" + path + "' (use .obj .off .ply .stl .glb .xyz .lammps)");
+    throw MeshError("cannot tell the output format from '" + path + "' (use .obj .off .ply .stl .glb .gltf .xyz .lammps)");
   const std::string bytes = write_mesh(soup, *format);
   std::ofstream out(path, std::ios::binary | std::ios::trunc);
   if (!out) throw std::runtime_error("cannot open '" + path + "' for writing");

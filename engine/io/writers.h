@@ -3,6 +3,7 @@
 /// Internal: one serialiser per output format (write_mesh() dispatches).
 
 #include <string>
+#include <string_view>
 
 #include "io/mesh_io.h"
 
@@ -15,6 +16,11 @@ std::string write_lammps(const PolygonSoup& soup);  ///< LAMMPS data: atoms, bon
 std::string write_ply(const PolygonSoup& soup);  ///< binary little endian, double coordinates
 std::string write_stl(const PolygonSoup& soup);  ///< binary, fan-triangulated, float32
 std::string write_glb(const PolygonSoup& soup);  ///< triangles (+ LINES of polygon edges)
+std::string write_gltf(const PolygonSoup& soup);  ///< the same document as text, its buffer a base64 data: URI
+
+/// Base64 (RFC 4648, padded) through tinygltf's encoder: defined in read_gltf.cpp, the one
+/// translation unit that compiles tinygltf.
+std::string base64(std::string_view bytes);
 
 /// Appends the shortest decimal text that reads back as exactly v.
 void append_number(std::string& out, double v);

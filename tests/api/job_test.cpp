@@ -125,8 +125,8 @@ TEST_CASE("job document: fields, links only when succeeded, round trip", "[api][
   CHECK(doc["timings"]["queued_seconds"] == Approx(1.0));
   CHECK(doc["timings"]["run_seconds"] == Approx(3.0));
   REQUIRE(doc["links"].contains("results"));
-  CHECK(doc["links"]["results"]["remeshed"].size() == 6);  // obj glb ply off stl lammps
-  CHECK(doc["links"]["results"]["dual"].size() == 6);      // obj glb ply off xyz lammps
+  CHECK(doc["links"]["results"]["remeshed"].size() == 7);  // obj glb gltf ply off stl lammps
+  CHECK(doc["links"]["results"]["dual"].size() == 7);      // obj glb gltf ply off xyz lammps
   CHECK(doc["links"]["results"]["dual"]["xyz"] == "/api/v1/jobs/" + r.id + "/result?mesh=dual&format=xyz");
   CHECK(doc["unwritable"] == json::array());
   {
@@ -135,10 +135,14 @@ TEST_CASE("job document: fields, links only when succeeded, round trip", "[api][
     far.unwritable = {"remeshed.stl", "dual.glb"};
     const json far_doc = job_to_json(far, "/api/v1", r.created_at + 100);
     CHECK(far_doc["unwritable"] == json::array({"remeshed.stl", "dual.glb"}));
-    CHECK(far_doc["links"]["results"]["remeshed"].size() == 5);
+    CHECK(far_doc["links"]["results"]["remeshed"].size() == 6);
     CHECK_FALSE(far_doc["links"]["results"]["remeshed"].contains("stl"));
     CHECK(far_doc["links"]["results"]["remeshed"].contains("glb"));
+    CHECK(far_doc["links"]["results"]["remeshed"].contains("gltf"));
+    // Text glTF stores float32 as GLB does: without GLB, no glTF link either.
+    CHECK(far_doc["links"]["results"]["dual"].size() == 5);
     CHECK_FALSE(far_doc["links"]["results"]["dual"].contains("glb"));
+    CHECK_FALSE(far_doc["links"]["results"]["dual"].contains("gltf"));
     CHECK(job_from_json(far_doc).unwritable == far.unwritable);  // stored and read back
   }
   CHECK(doc["links"]["results"]["remeshed"]["lammps"] ==

@@ -137,6 +137,13 @@ TEST_CASE("remeshd: submit raw and multipart, follow, download, list, delete", "
   CHECK(sum == Approx(steps["total"].get<double>()));
   CHECK(steps["total"].get<double>() <= done["timings"]["run_seconds"].get<double>());
   REQUIRE(done["links"].contains("results"));
+  // Text glTF is made on its first download, not when the job ends (below: it is the GLB's mesh).
+  for (const char* kind : {"remeshed", "dual"}) {
+    INFO(kind);
+    CHECK(done["links"]["results"][kind].contains("gltf"));
+    CHECK_FALSE(std::filesystem::exists(tmp.path / "data" / "jobs" / id / (std::string(kind) + ".gltf")));
+    CHECK(std::filesystem::exists(tmp.path / "data" / "jobs" / id / (std::string(kind) + ".glb")));
+  }
   for (const auto& [kind, formats] : done["links"]["results"].items())
     for (const auto& [fmt, url] : formats.items()) {
       auto f = c.Get(url.get<std::string>().c_str());
@@ -159,6 +166,24 @@ TEST_CASE("remeshd: submit raw and multipart, follow, download, list, delete", "
   auto glb = c.Get(("/api/v1/jobs/" + id + "/result?mesh=dual&format=glb").c_str());
   REQUIRE(glb);
   CHECK(glb->body.substr(0, 4) == "glTF");
+  for (const char* kind : {"remeshed", "dual", "input"}) {
+    INFO(kind);
+    const std::string url = "/api/v1/jobs/" + id + "/result?mesh=" + kind + "&format=";
+    auto text = c.Get((url + "gltf").c_str()), binary = c.Get((url + "glb").c_str());
+    REQUIRE(text);
+    REQUIRE(binary);
+    CHECK(text->status == 200);
+    CHECK(text->get_header_value("Content-Type") == "model/gltf+json");
+    CHECK(text->body.find(R"("uri":"data:application/octet-stream;base64,)") != std::string::npos);
+    const remesh::LoadedMesh from_text = remesh::read_mesh(text->body, {remesh::Format::Gltf});
+    const remesh::LoadedMesh from_binary = remesh::read_mesh(binary->body, {remesh::Format::Glb});
+    CHECK(from_text.mesh.n_vertices() == from_binary.mesh.n_vertices());
+    CHECK(from_text.mesh.n_faces() == from_binary.mesh.n_faces());
+    bool same_points = from_text.mesh.n_vertices() == from_binary.mesh.n_vertices();
+    for (auto v : from_text.mesh.vertices())
+      same_points = same_points && from_text.mesh.point(v) == from_binary.mesh.point(v);
+    CHECK(same_points);
+  }
   // LAMMPS data: the dual's atoms and bonds, the remeshed mesh's vertices and edges.
   for (const auto& [kind, atoms, bonds] :
        {std::tuple{"dual", dual["atoms"].get<int>(), dual["bonds"].get<int>()},
@@ -276,10 +301,13 @@ TEST_CASE("remeshd: a result float32 cannot hold succeeds, and its STL and GLB a
   CHECK_FALSE(done["links"]["results"]["remeshed"].contains("glb"));
   CHECK_FALSE(done["links"]["results"]["dual"].contains("glb"));
   CHECK(done["links"]["results"]["dual"].contains("xyz"));
+  // Text glTF stores float32 too.
+  CHECK_FALSE(done["links"]["results"]["remeshed"].contains("gltf"));
+  CHECK_FALSE(done["links"]["results"]["dual"].contains("gltf"));
   auto obj = c.Get(base + "?format=obj");
   REQUIRE(obj);
   CHECK(obj->status == 200);
-  for (const char* q : {"?format=stl", "?format=glb", "?mesh=dual&format=glb"}) {
+  for (const char* q : {"?format=stl", "?format=glb", "?mesh=dual&format=glb", "?format=gltf", "?mesh=dual&format=gltf"}) {
     INFO(q);
     auto g = c.Get(base + q);
     REQUIRE(g);

@@ -19,6 +19,18 @@ void put(std::string& out, T v, bool big) {
   out.append(reinterpret_cast<const char*>(raw), sizeof(T));
 }
 
+
+std::string ply_header(const PolygonSoup& soup, const char* format) {
+  return std::string("ply\nformat ") + format +
+         " 1.0\ncomment test file\nobj_info extra\nelement vertex " + std::to_string(soup.points.size()) +
+         "\nproperty float x\nproperty float y\nproperty float z\nproperty uchar red\nproperty double confidence\n"
+         "element face " + std::to_string(soup.offsets.size() - 1) +
+         "\nproperty uchar flags\nproperty list uchar int vertex_indices\nproperty float quality\n"
+         "element material 1\nproperty list ushort uchar name\nend_header\n";
+}
+
+}  // namespace
+
 std::string base64(const std::string& in) {
   static const char* t = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
   std::string out;
@@ -36,17 +48,6 @@ std::string base64(const std::string& in) {
   }
   return out;
 }
-
-std::string ply_header(const PolygonSoup& soup, const char* format) {
-  return std::string("ply\nformat ") + format +
-         " 1.0\ncomment test file\nobj_info extra\nelement vertex " + std::to_string(soup.points.size()) +
-         "\nproperty float x\nproperty float y\nproperty float z\nproperty uchar red\nproperty double confidence\n"
-         "element face " + std::to_string(soup.offsets.size() - 1) +
-         "\nproperty uchar flags\nproperty list uchar int vertex_indices\nproperty float quality\n"
-         "element material 1\nproperty list ushort uchar name\nend_header\n";
-}
-
-}  // namespace
 
 PolygonSoup make_soup(const std::vector<Vec3>& points, const std::vector<std::vector<std::uint32_t>>& faces) {
   PolygonSoup s;
@@ -165,6 +166,7 @@ std::vector<SampleFile> sample_files(const PolygonSoup& soup) {
       {"stl_ascii", Format::Stl, write_stl_ascii(soup)},
       {"stl_binary", Format::Stl, write_mesh(soup, Format::Stl)},
       {"gltf", Format::Gltf, write_gltf_data_uri(soup)},
+      {"gltf_written", Format::Gltf, write_mesh(soup, Format::Gltf)},
       {"glb", Format::Glb, write_mesh(soup, Format::Glb)},
   };
 }

@@ -25,6 +25,8 @@ std::string write_ply_ascii(const PolygonSoup& soup);
 std::string write_ply_big_endian(const PolygonSoup& soup);
 std::string write_off_binary(const PolygonSoup& soup);
 std::string write_stl_ascii(const PolygonSoup& soup);
+/// Base64 (RFC 4648, padded), written here independently of the engine's (tinygltf's).
+std::string base64(const std::string& in);
 /// A .gltf whose one buffer is a base64 data: URI (or `uri` verbatim if not empty).
 std::string write_gltf_data_uri(const PolygonSoup& soup, const std::string& uri = "");
 

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <limits>
 #include <set>
@@ -49,7 +50,7 @@ std::vector<Key> face_keys(const TriMesh& m, bool to_float) {
   return keys;
 }
 
-bool is_float_format(Format f) { return f == Format::Stl || f == Format::Glb; }
+bool is_float_format(Format f) { return f == Format::Stl || f == Format::Glb || f == Format::Gltf; }
 
 }  // namespace
 
@@ -59,7 +60,7 @@ TEST_CASE("Triangle meshes round-trip through every format") {
   meshes.emplace_back("torus", test::make_torus(12, 8, 2.0, 0.5));
   meshes.emplace_back("open grid", test::make_open_grid(5, 4, 0.3));
   for (auto& [name, mesh] : meshes) {
-    for (Format f : {Format::Obj, Format::Off, Format::Ply, Format::Stl, Format::Glb}) {
+    for (Format f : {Format::Obj, Format::Off, Format::Ply, Format::Stl, Format::Glb, Format::Gltf}) {
       INFO(name << " as " << format_name(f));
       const std::string bytes = write_mesh(mesh, f);
       CHECK(detect_format(bytes) == f);
@@ -89,7 +90,7 @@ TEST_CASE("Exact positions survive text formats, including awkward doubles") {
   }
 }
 
-TEST_CASE("STL and GLB refuse coordinates float32 cannot hold, before writing anything") {
+TEST_CASE("STL, GLB and glTF refuse coordinates float32 cannot hold, before writing anything") {
   // A tetrahedron 1e38 across with its apex at (0, 0, z); with `loose`, a point in no face there
   // (refused too: a mesh's vertices are all written, used or not).
   auto tetra = [](double z, double loose = 0) {
@@ -102,7 +103,7 @@ TEST_CASE("STL and GLB refuse coordinates float32 cannot hold, before writing an
   const auto dir =
       std::filesystem::temp_directory_path() / ("remesh_io_float32_" + std::to_string(::getpid()));
   std::filesystem::create_directories(dir);
-  for (const auto& [f, name] : {std::pair{Format::Stl, "STL"}, {Format::Glb, "GLB"}}) {
+  for (const auto& [f, name] : {std::pair{Format::Stl, "STL"}, {Format::Glb, "GLB"}, {Format::Gltf, "glTF"}}) {
     INFO(name);
     CHECK_THROWS_WITH(write_mesh(tetra(1e308), f),
                       std::string(name) + " cannot hold point 3 (0, 0, 1e+308): it stores coordinates as "
@@ -141,7 +142,7 @@ TEST_CASE("Polygon soups keep their polygons in OBJ, OFF and PLY, GLB adds a LIN
   CHECK(off.rfind("OFF\n8 6 0\n", 0) == 0);
   CHECK(off.find("\n4 0 3 2 1\n") != std::string::npos);
   CHECK(write_mesh(soup, Format::Obj).find("\nf 1 4 3 2\n") != std::string::npos);
-  for (Format f : {Format::Obj, Format::Off, Format::Ply, Format::Stl, Format::Glb}) {
+  for (Format f : {Format::Obj, Format::Off, Format::Ply, Format::Stl, Format::Glb, Format::Gltf}) {
     INFO(format_name(f));
     LoadedMesh back = read_mesh(write_mesh(soup, f));
     CHECK(back.mesh.n_faces() == 12);
@@ -154,6 +155,41 @@ TEST_CASE("Polygon soups keep their polygons in OBJ, OFF and PLY, GLB adds a LIN
   CHECK(glb.find(R"("mode":1)") != std::string::npos);  // LINES with the 12 cube edges
   CHECK(glb.find(R"("componentType":5125,"count":24,)") != std::string::npos);
   CHECK(write_mesh(test::make_icosphere(1), Format::Glb).find(R"("mode":1)") == std::string::npos);
+}
+
+TEST_CASE("Text glTF holds the GLB document, and its BIN chunk in base64") {
+  auto u32 = [](const std::string& s, std::size_t at) {
+    std::uint32_t v = 0;
+    std::memcpy(&v, s.data() + at, 4);
+    return v;
+  };
+  const PolygonSoup polygons = test::make_soup({{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, {0.5, 0.5, 1}},
+                                               {{0, 3, 2, 1}, {0, 1, 4}, {1, 2, 4}, {2, 3, 4}, {3, 0, 4}});
+  for (const PolygonSoup& soup : {to_soup(test::make_icosphere(2, 1.7)), polygons}) {
+    const std::string glb = write_mesh(soup, Format::Glb), gltf = write_mesh(soup, Format::Gltf);
+    // GLB: header (12 bytes), JSON chunk (length, type, padded text), BIN chunk.
+    const std::uint32_t json_length = u32(glb, 12);
+    std::string json = glb.substr(20, json_length);
+    while (!json.empty() && json.back() == ' ') json.pop_back();
+    const std::size_t bin_at = 20 + json_length;
+    REQUIRE(glb.substr(bin_at + 4, 4) == std::string("BIN\0", 4));
+    std::string bin = glb.substr(bin_at + 8, u32(glb, bin_at));
+    // The document states the unpadded length: the data URI holds that many bytes.
+    const std::string length_key = R"("buffers":[{"byteLength":)";
+    const std::size_t at = json.find(length_key);
+    REQUIRE(at != std::string::npos);
+    bin.resize(std::stoul(json.substr(at + length_key.size())));
+    const std::string expected =
+        json.substr(0, json.size() - 3) + R"(,"uri":"data:application/octet-stream;base64,)" + test::base64(bin) + "\"}]}\n";
+    CHECK(gltf == expected);
+  }
+  // An empty mesh: a document without buffers, as the GLB's.
+  const PolygonSoup empty = test::make_soup({}, {});
+  const std::string empty_glb = write_mesh(empty, Format::Glb);
+  std::string empty_json = empty_glb.substr(20, u32(empty_glb, 12));
+  while (!empty_json.empty() && empty_json.back() == ' ') empty_json.pop_back();
+  CHECK(empty_json.find("buffers") == std::string::npos);
+  CHECK(write_mesh(empty, Format::Gltf) == empty_json + "\n");
 }
 
 TEST_CASE("XYZ writes one carbon atom per point") {

@@ -155,13 +155,13 @@ async function submit(e) {
   const p = params.read_params();
   if (!state.file && view.job) {
     // Watching a job started elsewhere: run again on its (server-read) input, in its own format
-    // where the server writes it (OBJ, OFF and PLY hold the coordinates exactly; GLB has float32,
-    // as a glTF input had), so the new job keeps the input's name (it was renamed .glb).
+    // where the server writes it (OBJ, OFF and PLY hold the coordinates exactly; glTF has float32,
+    // as a glTF input had), so the new job keeps the input's name.
     const job = view.job;
     try {
       // The format the server read it as (a mesh named .txt is OBJ), else the name's extension.
       const name = job.input?.filename || 'input';
-      const own = [job.input?.format, format_of(name)].find((f) => ['obj', 'off', 'ply', 'stl', 'glb'].includes(f));
+      const own = [job.input?.format, format_of(name)].find((f) => ['obj', 'off', 'ply', 'stl', 'glb', 'gltf'].includes(f));
       const format = own || 'glb';
       const res = await api.request(api.result_url(job.id, 'input', format));
       const blob = await res.blob();

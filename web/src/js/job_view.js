@@ -8,8 +8,8 @@ import { IterationChart } from './charts.js';
 const $ = (id) => document.getElementById(id);
 export const FINAL = new Set(['succeeded', 'failed', 'cancelled']);
 const RESULT_FORMATS = {
-  remeshed: ['obj', 'glb', 'ply', 'off', 'stl', 'lammps'],
-  dual: ['obj', 'glb', 'ply', 'off', 'xyz', 'lammps'],
+  remeshed: ['obj', 'glb', 'gltf', 'ply', 'off', 'stl', 'lammps'],
+  dual: ['obj', 'glb', 'gltf', 'ply', 'off', 'xyz', 'lammps'],
 };
 const TABLE = [
   ['iteration', (v) => v], ['vertices', int], ['edges', int], ['mean', num], ['deviation', num],
