@@ -959,6 +959,7 @@ void HttpServer::Impl::post_job(const httplib::Request& req, httplib::Response& 
     UploadGate::Entry entry = upload_gate->enter();
     if (!entry.pass) {
       const bool closed = entry.refusal == UploadGate::Refusal::Closed;
+      metrics.count_busy(closed ? Metrics::Busy::ShuttingDown : Metrics::Busy::UploadSlots);
       res.set_header("Retry-After", closed ? "5" : "10");
       send_problem(res, 503,
                    closed ? std::string("the server is shutting down")
@@ -989,10 +990,12 @@ void HttpServer::Impl::post_job(const httplib::Request& req, httplib::Response& 
   JobRecord& record = prepared->record;
   switch (jobs.submit(record, body)) {
     case JobManager::Submit::QueueFull:
+      metrics.count_busy(Metrics::Busy::QueueFull);
       res.set_header("Retry-After", "10");
       send_problem(res, 503, "the job queue is full (" + std::to_string(options.queue_size) + " jobs); try again later");
       return;
     case JobManager::Submit::ShuttingDown:
+      metrics.count_busy(Metrics::Busy::ShuttingDown);
       res.set_header("Retry-After", "5");
       send_problem(res, 503, "the server is shutting down");
       return;
@@ -1055,6 +1058,7 @@ void HttpServer::Impl::events(const httplib::Request& req, httplib::Response& re
   std::size_t open = ++streams;
   if (open > options.max_streams) {
     --streams;
+    metrics.count_busy(Metrics::Busy::EventStreams);
     res.set_header("Retry-After", "5");
     send_problem(res, 503, "too many open event streams (" + std::to_string(options.max_streams) + "); retry later");
     return;

@@ -62,6 +62,11 @@ void Metrics::count_job_finished(const std::string& state) {
   ++finished_[state];
 }
 
+void Metrics::count_busy(Busy reason) {
+  std::lock_guard lock(mutex_);
+  ++busy_[static_cast<std::size_t>(reason)];
+}
+
 std::string Metrics::render(const Gauges& g) {
   using remesh::format_double;
   std::string o;
@@ -96,6 +101,13 @@ std::string Metrics::render(const Gauges& g) {
        "# TYPE remeshd_jobs_finished_total counter\n";
   for (const char* s : {"succeeded", "failed", "cancelled"})
     o += std::string("remeshd_jobs_finished_total{state=\"") + s + "\"} " + std::to_string(finished_[s]) + "\n";
+  // Every reason from the start (0), so that a rate over it needs no first refusal.
+  o += "# HELP remeshd_busy_refusals_total Requests answered 503, by reason.\n"
+       "# TYPE remeshd_busy_refusals_total counter\n";
+  for (const auto& [reason, name] : {std::pair{Busy::QueueFull, "queue_full"}, {Busy::UploadSlots, "upload_slots"},
+                                     {Busy::EventStreams, "event_streams"}, {Busy::ShuttingDown, "shutting_down"}})
+    o += std::string("remeshd_busy_refusals_total{reason=\"") + name + "\"} " +
+         std::to_string(busy_[static_cast<std::size_t>(reason)]) + "\n";
   o += "# HELP remeshd_http_requests_total HTTP requests by method, route and status.\n"
        "# TYPE remeshd_http_requests_total counter\n";
   for (const auto& [key, n] : requests_) {

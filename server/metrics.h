@@ -32,6 +32,11 @@ class Metrics {
   void count_iteration();
   /// Counts a job reaching a final state.
   void count_job_finished(const std::string& state);
+  /// Why a request got a 503: the job queue was full, no upload slot came free in time, the event
+  /// streams were all taken, or the service was stopping.
+  enum class Busy { QueueFull, UploadSlots, EventStreams, ShuttingDown };
+  /// Counts one 503 by its reason (remeshd_busy_refusals_total{reason}).
+  void count_busy(Busy reason);
   /// Prometheus text exposition format 0.0.4.
   std::string render(const Gauges& gauges);
 
@@ -51,6 +56,7 @@ class Metrics {
   std::uint64_t iterations_ = 0;
   std::deque<double> recent_iterations_;  ///< steady-clock times of the last minute's iterations
   std::map<std::string, std::uint64_t> finished_;
+  std::array<std::uint64_t, 4> busy_{};  ///< by Busy
 };
 
 }  // namespace remeshd

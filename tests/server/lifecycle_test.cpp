@@ -57,6 +57,13 @@ TEST_CASE("remeshd: cancel queued and running jobs, the queue bound", "[server][
   CHECK(full->status == 503);
   CHECK_FALSE(full->get_header_value("Retry-After").empty());
   CHECK(count_files(tmp.path / "data") == files);
+  // /metrics counts it as the queue's, and no other 503.
+  auto metrics = c.Get("/metrics");
+  REQUIRE(metrics);
+  CHECK(metrics->body.find("\nremeshd_busy_refusals_total{reason=\"queue_full\"} 1\n") != std::string::npos);
+  for (const char* other : {"upload_slots", "event_streams", "shutting_down"})
+    CHECK(metrics->body.find("\nremeshd_busy_refusals_total{reason=\"" + std::string(other) + "\"} 0\n") !=
+          std::string::npos);
 
   // Cancel the queued job: cancelled at once.
   auto cq = c.Delete(("/api/v1/jobs/" + queued).c_str());
@@ -272,6 +279,10 @@ TEST_CASE("remeshd: large uploads are read a few at a time, one that finds no sl
     CHECK(refused->status == 503);
     CHECK(refused->get_header_value("Retry-After") == "10");
     CHECK(refused->body.find("--upload-slots") != std::string::npos);
+    // Counted by its reason (each attempt's refusal, this one included, was a 503 of the gate's).
+    CHECK(metrics->body.find("\nremeshd_busy_refusals_total{reason=\"upload_slots\"} ") != std::string::npos);
+    CHECK(metrics->body.find("\nremeshd_busy_refusals_total{reason=\"upload_slots\"} 0\n") == std::string::npos);
+    CHECK(metrics->body.find("\nremeshd_busy_refusals_total{reason=\"queue_full\"} 0\n") != std::string::npos);
   }
   CHECK(seen);
   auto small = submit_raw(c, sphere_obj(2), "emin=0.2&emax=0.35&iterations=1");

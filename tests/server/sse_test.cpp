@@ -104,6 +104,9 @@ TEST_CASE("remeshd SSE: stream cap, lifetime with retry, heartbeats", "[server][
   REQUIRE(third);
   CHECK(third->status == 503);
   CHECK_FALSE(third->get_header_value("Retry-After").empty());
+  auto metrics = c.Get("/metrics");
+  REQUIRE(metrics);
+  CHECK(metrics->body.find("\nremeshd_busy_refusals_total{reason=\"event_streams\"} 1\n") != std::string::npos);
   ta.join();
   tb.join();
   // Each stream ended after its lifetime with a retry hint, pings in between.
