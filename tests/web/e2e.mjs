@@ -242,6 +242,31 @@ async function main() {
   check(obj.vertices - obj.edges + obj.faces === 2, `remeshed.obj is still a sphere (Euler ${obj.vertices - obj.edges + obj.faces})`);
   check(last.vertices === undefined || Math.abs(obj.vertices - last.vertices) <= 0.2 * last.vertices,
     `vertex count near the last row's (${obj.vertices} vs ${last.vertices})`);
+  // Text glTF: the dual's, its buffer inside, one position per atom.
+  const [gltf_download] = await Promise.all([page.waitForEvent('download', { timeout: 10000 }),
+    page.click('#downloads button[aria-label="Download dual as gltf"]')]);
+  const gltf_path = path.join(artifacts, 'dual.gltf');
+  await gltf_download.saveAs(gltf_path);
+  let gltf = null;
+  try { gltf = JSON.parse(fs.readFileSync(gltf_path, 'utf8')); } catch { /* checked below */ }
+  check(gltf?.asset?.version === '2.0' && gltf.buffers?.[0]?.uri?.startsWith('data:application/octet-stream;base64,') &&
+    gltf.accessors?.[0]?.count === job_doc.dual.atoms,
+    `dual.gltf is glTF 2.0 with its buffer inside and a position per atom (${gltf?.accessors?.[0]?.count} vs ${job_doc.dual.atoms})`);
+  // A job whose GLB the server could not write (float32): no GLB nor glTF button, the rest stay.
+  const buttons = await page.evaluate(() => {
+    const view = window.__remeshd.view;
+    const job = view.job;
+    view.job = { ...job, unwritable: ['dual.glb', 'remeshed.stl'] };
+    view.render_downloads();
+    const labels = [...document.querySelectorAll('#downloads button')].map((b) => b.getAttribute('aria-label'));
+    view.job = job;
+    view.render_downloads();
+    return labels;
+  });
+  check(!buttons.includes('Download dual as glb') && !buttons.includes('Download dual as gltf') &&
+    !buttons.includes('Download remeshed as stl') && buttons.includes('Download remeshed as gltf') &&
+    buttons.includes('Download dual as obj'),
+    `downloads leave out what the server could not write, glTF with GLB (${buttons.filter((b) => /dual|stl/.test(b)).join(', ')})`);
 
   // --- many rows at once (a fast job's stream chunk: one event each, in one task) are all kept and
   // reach the table together in one later frame; the table follows the newest row while the user

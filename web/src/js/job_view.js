@@ -320,10 +320,11 @@ export class JobView {
     };
     if (job.state === 'succeeded') {
       // Not the files the formats cannot hold (float32 STL and GLB of a mesh past 3.4e38): the
-      // server names them, and a download of one is refused.
+      // server names them, and a download of one is refused. Text glTF stores float32 as GLB does.
       const unwritable = new Set(job.unwritable || []);
+      const cannot = (mesh, f) => unwritable.has(`${mesh}.${f}`) || (f === 'gltf' && unwritable.has(`${mesh}.glb`));
       for (const mesh of ['remeshed', 'dual'])
-        group(mesh, RESULT_FORMATS[mesh].filter((f) => !unwritable.has(`${mesh}.${f}`))
+        group(mesh, RESULT_FORMATS[mesh].filter((f) => !cannot(mesh, f))
           .map((f) => [f, api.result_url(job.id, mesh, f), `${base}_${mesh}.${f}`]));
     }
     group('statistics', [['csv', api.stats_csv_url(job.id), `${base}_stats.csv`]]);
