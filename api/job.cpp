@@ -56,7 +56,8 @@ json format_links(const std::string& base, const std::string& mesh, const std::v
   auto cannot = [&](const std::string& f) {
     return std::find(unwritable.begin(), unwritable.end(), mesh + "." + f) != unwritable.end();
   };
-  // Text glTF stores float32 as GLB does: a mesh GLB cannot hold, it cannot either.
+  // Text glTF stores float32 as GLB does: a mesh GLB cannot hold, it cannot either (the runner
+  // names both; a job stored before glTF was added names only the GLB).
   for (const std::string& f : formats)
     if (!cannot(f) && !(f == "gltf" && cannot("glb"))) links[f] = base + "/result?mesh=" + mesh + "&format=" + f;
   return links;

@@ -1171,7 +1171,7 @@ void HttpServer::Impl::result(const httplib::Request& req, httplib::Response& re
   try {
     path = jobs.file(rec->id, mesh + "." + format);
   } catch (const std::range_error& e) {
-    // The format cannot hold this mesh (STL and GLB store float32: a mesh placed beyond 3.4e38).
+    // The format cannot hold this mesh (STL, GLB and glTF store float32: a mesh placed beyond 3.4e38).
     send_problem(res, 422, std::string("this mesh cannot be written as ") + format + ": " + e.what());
     return;
   } catch (const std::exception& e) {

@@ -470,7 +470,27 @@ std::filesystem::path JobManager::file(const std::string& id, const std::string&
   const std::size_t dot = name.find('.');
   const std::filesystem::path obj = store_.file_path(id, name.substr(0, dot) + ".obj");
   if (!input && (dot == std::string::npos || !std::filesystem::exists(obj))) return path;
-  std::lock_guard file_lock(file_mutex_);
+  const std::string key = id + "/" + name;
+  std::shared_ptr<std::mutex> making;
+  {
+    std::lock_guard lock(making_mutex_);
+    std::shared_ptr<std::mutex>& slot = making_[key];
+    if (!slot) slot = std::make_shared<std::mutex>();
+    making = slot;
+  }
+  // The entry goes when the last request for the file is done with it (made or failed).
+  struct Release {
+    JobManager& jobs;
+    const std::string& key;
+    std::shared_ptr<std::mutex>& making;
+    ~Release() {
+      std::lock_guard lock(jobs.making_mutex_);
+      auto it = jobs.making_.find(key);
+      making.reset();
+      if (it != jobs.making_.end() && it->second.use_count() == 1) jobs.making_.erase(it);
+    }
+  } release{*this, key, making};
+  std::lock_guard file_lock(*making);
   if (std::filesystem::exists(path)) return path;
   auto rec = record(id);
   if (!rec) throw std::runtime_error("job not found");

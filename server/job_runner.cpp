@@ -1,5 +1,6 @@
 #include "job_runner.h"
 
+#include <algorithm>
 #include <charconv>
 #include <stdexcept>
 
@@ -52,12 +53,16 @@ RunOutput run_job(const remesh::api::JobRecord& job, std::string upload, unsigne
   };
   if (stopped()) return out;
   collect_garbage(mesh);
-  // A format that cannot hold the result (STL and GLB store float32: a mesh placed beyond 3.4e38)
-  // is not written; a download of it makes it then, and is refused saying why. The job succeeds
-  // with the others.
+  // A format that cannot hold the result (STL, GLB and glTF store float32: a mesh placed beyond
+  // 3.4e38) is not written; a download of it makes it then, and is refused saying why. The job
+  // succeeds with the others. Text glTF is made on request; it holds what GLB holds.
   auto write_each = [&](const std::string& stem, const auto& m, const std::vector<std::string>& formats) {
     for (const std::string& f : formats) {
-      if (remesh::api::made_on_request(f)) continue;
+      if (remesh::api::made_on_request(f)) {
+        const auto& none = out.unwritable;
+        if (std::find(none.begin(), none.end(), stem + ".glb") != none.end()) out.unwritable.push_back(stem + "." + f);
+        continue;
+      }
       std::string bytes;
       try {
         bytes = remesh::write_mesh(m, format_of(f));

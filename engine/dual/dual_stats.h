@@ -21,7 +21,8 @@ inline double edge_for_bond(double bond) { return bond * std::sqrt(3.0); }
 /// The dual edge (bond) of equilateral triangles of side `edge`: edge / sqrt(3), to 15 significant
 /// digits. A bond interval comes back as given: bond * sqrt(3) / sqrt(3) in doubles is not always
 /// the bond (1.278 gave 1.2779999999999998, about one bond in ten), and 15 digits are exact for
-/// every decimal of up to 15 digits; they change any other value by at most 5e-15 of it.
+/// every decimal of up to 15 digits; they change any other value by at most about 5e-15 of it
+/// (half a unit of the 15th digit, and the rounding to the nearest double).
 double bond_for_edge(double edge);
 
 struct DualStats {

@@ -92,13 +92,14 @@ PolygonSoup to_soup(const TriMesh& mesh);
 PolygonSoup to_soup(const PolyMesh& mesh);
 
 /// Serialises to bytes. Polygons: OBJ/OFF/PLY keep them; STL fan-triangulates; GLB writes a
-/// triangle-fan primitive plus a LINES primitive of the true polygon edges; XYZ writes one atom
+/// triangle-fan primitive plus a LINES primitive of the true polygon edges (points without faces:
+/// a POINTS primitive); XYZ writes one atom
 /// ("C x y z") per point; Lammps writes a LAMMPS data file (atom_style bond): one carbon atom per
 /// point and one bond per edge of the faces (no Bonds section without edges), in a box 5 % wider
 /// than their bounding box. Gltf is the GLB's document as text, its buffer a base64 data: URI. XYZ
 /// and Lammps are written, not read. Throws std::invalid_argument for unsupported;
-/// std::range_error for STL, GLB and glTF, which store float32,
-/// when a point has a coordinate of about 3.4e38 or more in magnitude (nothing is written).
+/// std::range_error for STL, GLB and glTF, which store float32, when a point has a coordinate of
+/// about 3.4e38 or more in magnitude, and for GLB and glTF past 4 GiB of data (nothing is written).
 std::string write_mesh(const PolygonSoup& soup, Format format);
 std::string write_mesh(const TriMesh& mesh, Format format);
 std::string write_mesh(const PolyMesh& mesh, Format format);

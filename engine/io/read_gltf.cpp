@@ -17,7 +17,6 @@
 
 #include "io/parse_util.h"
 #include "io/soup.h"
-#include "io/writers.h"
 
 namespace remesh::io {
 
@@ -407,18 +406,3 @@ RawSoup read_gltf(std::string_view bytes, bool binary, const ReadOptions& option
 
 }  // namespace remesh::io
 
-// tinygltf's encoder (libtinygltf exports it); tiny_gltf.h declares it only under
-// TINYGLTF_IMPLEMENTATION, which the library's own build defines.
-namespace tinygltf {
-std::string base64_encode(unsigned char const* bytes_to_encode, unsigned int in_len);
-}
-
-namespace remesh::io {
-
-// Here, beside the reader, so that tiny_gltf.h is compiled in one translation unit (writers.h).
-std::string base64(std::string_view bytes) {
-  return tinygltf::base64_encode(reinterpret_cast<const unsigned char*>(bytes.data()),
-                                 static_cast<unsigned int>(bytes.size()));
-}
-
-}  // namespace remesh::io

@@ -1,12 +1,16 @@
 /// \file write_glb.cpp
-/// glTF 2.0 writers: GLB, and text .gltf with its buffer in a data: URI (the document is built
-/// here; tinygltf reads, and encodes the base64). One buffer with 4-byte aligned views: float32
-/// POSITION (with min/max), UNSIGNED_INT triangle indices (faces fan-triangulated) and, when any
-/// face is not a triangle, a LINES primitive sharing POSITION that carries every polygon edge once.
+/// glTF 2.0 writers: GLB, and text .gltf with its buffer in a base64 data: URI (built here;
+/// tinygltf only reads). One buffer with 4-byte aligned views: float32 POSITION (with min/max),
+/// UNSIGNED_INT triangle indices (faces fan-triangulated) and, when any face is not a triangle, a
+/// LINES primitive sharing POSITION that carries every polygon edge once. Points without faces (the
+/// dual of a mesh with no interior vertex) are a POINTS primitive; no points, a scene without nodes.
 
 #include <algorithm>
+#include <cstdint>
 #include <cstring>
 #include <limits>
+#include <stdexcept>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -40,6 +44,32 @@ std::string number(double v) {
   return s;
 }
 
+/// Base64 (RFC 4648, padded).
+std::string base64(const std::string& in) {
+  static constexpr char kDigits[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  std::string out;
+  out.reserve((in.size() + 2) / 3 * 4);
+  auto byte = [&](std::size_t i) { return static_cast<std::uint32_t>(static_cast<unsigned char>(in[i])); };
+  std::size_t i = 0;
+  for (; i + 3 <= in.size(); i += 3) {
+    const std::uint32_t v = byte(i) << 16 | byte(i + 1) << 8 | byte(i + 2);
+    out += {kDigits[v >> 18], kDigits[(v >> 12) & 63], kDigits[(v >> 6) & 63], kDigits[v & 63]};
+  }
+  if (const std::size_t rest = in.size() - i; rest > 0) {
+    const std::uint32_t v = byte(i) << 16 | (rest == 2 ? byte(i + 1) << 8 : 0);
+    out += {kDigits[v >> 18], kDigits[(v >> 12) & 63], rest == 2 ? kDigits[(v >> 6) & 63] : '=', '='};
+  }
+  return out;
+}
+
+/// GLB and glTF state their lengths and offsets in 32 bits (GLB's header and chunks; the index
+/// type UNSIGNED_INT): past that the file would be silently wrong.
+void check_length(std::size_t bytes, const char* format) {
+  if (bytes > std::numeric_limits<std::uint32_t>::max())
+    throw std::range_error(std::string(format) + " cannot hold " + std::to_string(bytes) +
+                           " bytes of vertices and indices: its lengths are 32-bit, at most 4 GiB");
+}
+
 /// The glTF JSON document of `soup` and its binary buffer (`bin`, unpadded). With `embed`, the
 /// buffer is in the document as a base64 data: URI (text .gltf); without, it is the GLB's BIN chunk.
 std::string gltf_document(const PolygonSoup& soup, std::string& bin, bool embed) {
@@ -63,10 +93,11 @@ std::string gltf_document(const PolygonSoup& soup, std::string& bin, bool embed)
   for (std::uint32_t i : tris) put_le<std::uint32_t>(bin, i);
   const std::size_t line_offset = bin.size();
   for (std::uint32_t i : lines) put_le<std::uint32_t>(bin, i);
+  check_length(bin.size(), embed ? "glTF" : "GLB");
 
   std::string json = R"({"asset":{"version":"2.0","generator":"remeshd"},"scene":0,)";
-  if (soup.points.empty() || (tris.empty() && lines.empty())) {
-    json += R"("scenes":[{"nodes":[]}]})";
+  if (soup.points.empty()) {
+    json += R"("scenes":[{}]})";  // an empty "nodes" is not valid glTF
   } else {
     const std::string n = std::to_string(soup.points.size());
     json += R"("scenes":[{"nodes":[0]}],"nodes":[{"mesh":0}],"meshes":[{"primitives":[)";
@@ -86,6 +117,7 @@ std::string gltf_document(const PolygonSoup& soup, std::string& bin, bool embed)
     };
     if (!tris.empty()) add(tri_offset, tris.size(), 4);
     if (!lines.empty()) add(line_offset, lines.size(), 1);
+    if (tris.empty() && lines.empty()) prims = R"({"attributes":{"POSITION":0},"mode":0})";  // POINTS
     json += prims + R"(]}],"accessors":[)" + accessors + R"(],"bufferViews":[)" + views + "],";
     json += R"("buffers":[{"byteLength":)" + std::to_string(bin.size());
     if (embed) json += R"(,"uri":"data:application/octet-stream;base64,)" + base64(bin) + '"';
@@ -109,6 +141,7 @@ std::string write_glb(const PolygonSoup& soup) {
   while (json.size() % 4) json += ' ';
   while (bin.size() % 4) bin += '\0';
   const bool has_bin = !bin.empty();
+  check_length(12 + 8 + json.size() + (has_bin ? 8 + bin.size() : 0), "GLB");
   std::string out = "glTF";
   put_le<std::uint32_t>(out, 2);
   put_le<std::uint32_t>(out, static_cast<std::uint32_t>(12 + 8 + json.size() + (has_bin ? 8 + bin.size() : 0)));

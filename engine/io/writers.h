@@ -3,7 +3,6 @@
 /// Internal: one serialiser per output format (write_mesh() dispatches).
 
 #include <string>
-#include <string_view>
 
 #include "io/mesh_io.h"
 
@@ -18,15 +17,11 @@ std::string write_stl(const PolygonSoup& soup);  ///< binary, fan-triangulated, 
 std::string write_glb(const PolygonSoup& soup);  ///< triangles (+ LINES of polygon edges)
 std::string write_gltf(const PolygonSoup& soup);  ///< the same document as text, its buffer a base64 data: URI
 
-/// Base64 (RFC 4648, padded) through tinygltf's encoder: defined in read_gltf.cpp, the one
-/// translation unit that compiles tinygltf.
-std::string base64(std::string_view bytes);
-
 /// Appends the shortest decimal text that reads back as exactly v.
 void append_number(std::string& out, double v);
 
 /// Throws std::range_error, naming `format` and the first such point, if a coordinate does not
-/// round to a finite float32 (magnitude about 3.4e38 or more): STL and GLB store float32.
+/// round to a finite float32 (magnitude about 3.4e38 or more): STL, GLB and glTF store float32.
 void check_float32(const PolygonSoup& soup, const char* format);
 
 /// Fan triangles of every face: (f0, fi, fi+1).

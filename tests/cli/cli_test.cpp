@@ -314,7 +314,7 @@ TEST_CASE("convert round trips obj -> ply/off/stl/glb/gltf -> obj keep the count
   }
 }
 
-TEST_CASE("convert refuses coordinates STL and GLB cannot hold: exit 1, one line, nothing written", "[cli]") {
+TEST_CASE("convert refuses coordinates STL, GLB and glTF cannot hold: exit 1, one line, nothing written", "[cli]") {
   TempDir dir;
   // A tetrahedron with corners at 1e308: it reads (doubles), but float32 ends near 3.4e38.
   std::ofstream(dir.file("far.obj")) << "v 0 0 0\nv 1e308 0 0\nv 0 1e308 0\nv 0 0 1e308\n"

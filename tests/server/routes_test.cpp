@@ -260,6 +260,48 @@ TEST_CASE("remeshd: submit raw and multipart, follow, download, list, delete", "
         std::string::npos);
 }
 
+TEST_CASE("remeshd: files made on request, asked for at once, are made once each and served alike", "[server]") {
+  TempDir tmp;
+  Daemon d(tmp.path / "data", {"--workers", "1", "--http-threads", "24"});
+  auto c = d.client();
+  auto r = submit_raw(c, sphere_obj(3), "emin=0.1&emax=0.16&filename=ball.obj");
+  REQUIRE(r);
+  REQUIRE(r->status == 202);
+  const std::string id = body_of(r)["id"];
+  REQUIRE(wait_final(c, id)["state"] == "succeeded");
+  const std::vector<std::string> urls = {"/api/v1/jobs/" + id + "/result?mesh=remeshed&format=gltf",
+                                         "/api/v1/jobs/" + id + "/result?mesh=dual&format=gltf",
+                                         "/api/v1/jobs/" + id + "/result?mesh=input&format=gltf",
+                                         "/api/v1/jobs/" + id + "/result?mesh=input&format=ply"};
+  constexpr int kEach = 4;
+  std::vector<std::pair<int, std::string>> got(urls.size() * kEach);
+  std::vector<std::thread> threads;
+  for (std::size_t i = 0; i < got.size(); ++i)
+    threads.emplace_back([&, i] {
+      auto own = d.client();
+      if (auto g = own.Get(urls[i % urls.size()].c_str())) got[i] = {g->status, g->body};
+    });
+  for (auto& t : threads) t.join();
+  for (std::size_t i = 0; i < got.size(); ++i) {
+    INFO(urls[i % urls.size()]);
+    CHECK(got[i].first == 200);
+    CHECK_FALSE(got[i].second.empty());
+    CHECK(got[i].second == got[i % urls.size()].second);
+  }
+  // Each file once in the job's directory, whole (what a later request reads), no leftovers.
+  std::set<std::string> names;
+  for (const auto& entry : std::filesystem::directory_iterator(tmp.path / "data" / "jobs" / id))
+    names.insert(entry.path().filename().string());
+  for (const char* name : {"remeshed.gltf", "dual.gltf", "input.gltf", "input.ply"}) {
+    INFO(name);
+    CHECK(names.count(name) == 1);
+  }
+  for (const std::string& name : names) CHECK(name.find(".tmp") == std::string::npos);
+  auto again = c.Get(urls[0].c_str());
+  REQUIRE(again);
+  CHECK(again->body == got[0].second);
+}
+
 TEST_CASE("remeshd: a job whose mesh lies over itself throughout is said to be layered, its crossings uncounted",
           "[server]") {
   // Sixteen copies of a ball at one place, as a file instancing a part at one spot gives.
@@ -280,8 +322,8 @@ TEST_CASE("remeshd: a job whose mesh lies over itself throughout is said to be l
   CHECK(done["crossing_pairs"].is_null());
 }
 
-TEST_CASE("remeshd: a result float32 cannot hold succeeds, and its STL and GLB are refused saying why", "[server]") {
-  // A ball placed 1e39 from the origin: its OBJ, PLY and OFF hold it, STL and GLB (float32) not.
+TEST_CASE("remeshd: a result float32 cannot hold succeeds, and its STL, GLB and glTF are refused saying why", "[server]") {
+  // A ball placed 1e39 from the origin: its OBJ, PLY and OFF hold it, STL, GLB and glTF (float32) not.
   TempDir tmp;
   Daemon d(tmp.path / "data");
   auto c = d.client();
@@ -295,7 +337,7 @@ TEST_CASE("remeshd: a result float32 cannot hold succeeds, and its STL and GLB a
   REQUIRE(done["state"] == "succeeded");
   const std::string base = "/api/v1/jobs/" + done["id"].get<std::string>() + "/result";
   // The job names those files and links only the others (it linked all, each to a 422).
-  CHECK(done["unwritable"] == json::array({"remeshed.glb", "remeshed.stl", "dual.glb"}));
+  CHECK(done["unwritable"] == json::array({"remeshed.glb", "remeshed.gltf", "remeshed.stl", "dual.glb", "dual.gltf"}));
   CHECK(done["links"]["results"]["remeshed"].contains("obj"));
   CHECK_FALSE(done["links"]["results"]["remeshed"].contains("stl"));
   CHECK_FALSE(done["links"]["results"]["remeshed"].contains("glb"));

@@ -246,7 +246,7 @@ TEST_CASE("run_job hands each result file to the sink once, and none when cancel
   CHECK(static_cast<long>(back.mesh.n_vertices()) - static_cast<long>(back.mesh.n_edges()) +
             static_cast<long>(back.mesh.n_faces()) == 2);
 
-  // The same sphere placed 1e39 from the origin: STL and GLB (float32) cannot hold it and are not
+  // The same sphere placed 1e39 from the origin: STL, GLB and glTF (float32) cannot hold it and are not
   // written; the job's other files are (the run failed while writing them).
   {
     // 1e25 across (near 1e39 doubles lie about 1e23 apart: the sphere of radius 10 would be flat).
@@ -259,6 +259,9 @@ TEST_CASE("run_job hands each result file to the sink once, and none when cancel
     const RunOutput far_out = run_job(far_job, remesh::write_mesh(far, remesh::Format::Off), 1, {}, std::stop_token{},
                                       [&](const std::string& name, std::string_view) { written.insert(name); });
     CHECK(far_out.result.outcome != remesh::Outcome::Cancelled);
+    // Named unwritable, text glTF with GLB (made on request, it stores float32 too).
+    CHECK(std::set<std::string>(far_out.unwritable.begin(), far_out.unwritable.end()) ==
+          std::set<std::string>{"remeshed.stl", "remeshed.glb", "remeshed.gltf", "dual.glb", "dual.gltf"});
     std::set<std::string> without_float32;
     for (const std::string& name : expected)
       if (!name.ends_with(".stl") && !name.ends_with(".glb")) without_float32.insert(name);

@@ -1,7 +1,7 @@
 // The glTF the product writes, checked by the Khronos glTF validator (gltf-validator from the npm
 // registry, in web/node_modules): a remeshed sphere and its trivalent dual (polygons: triangle fans
-// plus a LINES primitive), each as .glb and as .gltf, written by the `remesh` CLI (the daemon's
-// downloads are the same writer). Every file must have no error and no warning, and the validator's
+// plus a LINES primitive), and the dual of one triangle (a POINTS primitive), each as .glb and as
+// .gltf, written by the `remesh` CLI (the daemon's downloads are the same writer). Every file must have no error and no warning, and the validator's
 // own count of triangles must be the mesh's (`remesh info --json` on the OBJ written beside it).
 // Environment: REMESH (the CLI). Exits non-zero with one line per failed check.
 
@@ -60,6 +60,13 @@ async function main() {
     const dual = await validate(`dual.${ext}`, fan_triangles(file('dual.obj')));
     // The dual's polygons: a second primitive (LINES) for their true edges.
     check(dual.info?.drawCallCount === 2, `dual.${ext}: two primitives, fans and LINES (${dual.info?.drawCallCount})`);
+  }
+  // The dual of one triangle: an atom and no ring, a POINTS primitive (an empty scene was invalid).
+  fs.writeFileSync(file('triangle.obj'), 'v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n');
+  for (const ext of ['glb', 'gltf']) {
+    run('dual', file('triangle.obj'), file(`atom.${ext}`));
+    const report = await validate(`atom.${ext}`, 0);
+    check(report.info?.totalVertexCount === 1, `atom.${ext}: one vertex (${report.info?.totalVertexCount})`);
   }
   // Text glTF carries its buffer inside: nothing beside it to load.
   const text = JSON.parse(fs.readFileSync(file('remeshed.gltf'), 'utf8'));

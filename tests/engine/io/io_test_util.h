@@ -1,8 +1,8 @@
 #pragma once
 /// \file io_test_util.h
 /// Helpers for the io tests: a small mesh serialised in every input format (including the
-/// variants our writers do not produce: ASCII/big-endian PLY, binary OFF, ASCII STL, .gltf with a
-/// data: URI), and an independent validity check of a loaded mesh.
+/// variants our writers do not produce: ASCII/big-endian PLY, binary OFF, ASCII STL, a .gltf of
+/// 16-bit indices), and an independent validity check of a loaded mesh.
 
 #include <string>
 #include <vector>

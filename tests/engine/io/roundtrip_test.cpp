@@ -183,12 +183,20 @@ TEST_CASE("Text glTF holds the GLB document, and its BIN chunk in base64") {
         json.substr(0, json.size() - 3) + R"(,"uri":"data:application/octet-stream;base64,)" + test::base64(bin) + "\"}]}\n";
     CHECK(gltf == expected);
   }
-  // An empty mesh: a document without buffers, as the GLB's.
+  // Points without faces (the dual of a single triangle: one atom): a POINTS primitive.
+  const PolygonSoup atoms = test::make_soup({{0, 0, 0}, {1, 0, 0}, {0, 2, 0}}, {});
+  for (Format f : {Format::Glb, Format::Gltf}) {
+    const std::string bytes = write_mesh(atoms, f);
+    CHECK(bytes.find(R"("primitives":[{"attributes":{"POSITION":0},"mode":0}])") != std::string::npos);
+    CHECK(bytes.find(R"("count":3,"type":"VEC3")") != std::string::npos);
+  }
+  // An empty mesh: a document without buffers, as the GLB's, its scene without nodes.
   const PolygonSoup empty = test::make_soup({}, {});
   const std::string empty_glb = write_mesh(empty, Format::Glb);
   std::string empty_json = empty_glb.substr(20, u32(empty_glb, 12));
   while (!empty_json.empty() && empty_json.back() == ' ') empty_json.pop_back();
   CHECK(empty_json.find("buffers") == std::string::npos);
+  CHECK(empty_json.find(R"("scenes":[{}])") != std::string::npos);  // an empty "nodes" is invalid glTF
   CHECK(write_mesh(empty, Format::Gltf) == empty_json + "\n");
 }
 

@@ -319,7 +319,7 @@ export class JobView {
       box.append(g);
     };
     if (job.state === 'succeeded') {
-      // Not the files the formats cannot hold (float32 STL and GLB of a mesh past 3.4e38): the
+      // Not the files the formats cannot hold (float32 STL, GLB and glTF of a mesh past 3.4e38): the
       // server names them, and a download of one is refused. Text glTF stores float32 as GLB does.
       const unwritable = new Set(job.unwritable || []);
       const cannot = (mesh, f) => unwritable.has(`${mesh}.${f}`) || (f === 'gltf' && unwritable.has(`${mesh}.glb`));
