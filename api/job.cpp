@@ -63,6 +63,17 @@ json format_links(const std::string& base, const std::string& mesh, const std::v
   return links;
 }
 
+/// {hausdorff, relative, result_to_input, input_to_result, diagonal}: relative = hausdorff / diagonal
+/// (0 for a point-sized input).
+json distance_to_json(const JobRecord::DistanceToInput& d) {
+  const double h = d.distance.hausdorff();
+  return {{"hausdorff", h},
+          {"relative", d.diagonal > 0 ? h / d.diagonal : 0.0},
+          {"result_to_input", d.distance.result_to_input},
+          {"input_to_result", d.distance.input_to_result},
+          {"diagonal", d.diagonal}};
+}
+
 /// {stellar, ..., setup, other, total} (kPhaseFields): other = total minus the steps.
 json step_seconds_to_json(const JobRecord::StepSeconds& s) {
   json j = json::object();
@@ -218,6 +229,7 @@ json job_to_json(const JobRecord& job, std::string_view prefix, double now) {
       {"triangles", job.triangles ? json(*job.triangles) : json(nullptr)},
       {"seconds_by_step", job.seconds_by_step ? step_seconds_to_json(*job.seconds_by_step) : json(nullptr)},
       {"dual", job.dual ? dual_to_json(*job.dual) : json(nullptr)},
+      {"distance_to_input", job.distance_to_input ? distance_to_json(*job.distance_to_input) : json(nullptr)},
       {"error", job.error ? json(*job.error) : json(nullptr)},
       {"attempts", job.attempts},
       {"timings",
@@ -281,6 +293,11 @@ JobRecord job_from_json(const json& j) {
       job.seconds_by_step = step_seconds_from_json(*t);
     // Absent in documents written before the field existed.
     if (const auto d = j.find("dual"); d != j.end() && !d->is_null()) job.dual = dual_from_json(*d);
+    // Absent in documents written before the field existed.
+    if (const auto d = j.find("distance_to_input"); d != j.end() && !d->is_null())
+      job.distance_to_input = JobRecord::DistanceToInput{
+          {d->at("result_to_input").get<double>(), d->at("input_to_result").get<double>()},
+          d->at("diagonal").get<double>()};
     if (!j.at("error").is_null()) job.error = j.at("error").get<std::string>();
     job.attempts = j.value("attempts", 0);  // absent in documents written before the field existed
     return job;

@@ -16,7 +16,7 @@
 #endif
 #include "remesh/geometry.h"
 #include "remesh/statistics.h"
-#include "triangle_bvh.h"
+#include "remesh/triangle_bvh.h"
 
 namespace remesh::bench {
 

@@ -336,6 +336,7 @@ void JobManager::run(const std::string& id) {
       r.triangles = result.triangles;
       r.unwritable = out.unwritable;
       r.dual = out.dual;
+      r.distance_to_input = out.distance;
       r.seconds_by_step = remesh::api::JobRecord::StepSeconds{result.phases, result.seconds};
     });
     // Cancelled late: its result files go (never served: a job serves results only once it has

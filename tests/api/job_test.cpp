@@ -58,6 +58,7 @@ TEST_CASE("job document: fields, links only when succeeded, round trip", "[api][
   CHECK(doc["triangles"].is_null());
   CHECK(doc["seconds_by_step"].is_null());
   CHECK(doc["dual"].is_null());
+  CHECK(doc["distance_to_input"].is_null());
   CHECK(doc["error"].is_null());
   CHECK(doc["params"]["emin"] == 0.5);
   CHECK(doc["params"]["weld"] == false);
@@ -95,7 +96,10 @@ TEST_CASE("job document: fields, links only when succeeded, round trip", "[api][
   dual.mean = 0.875, dual.deviation = 0.0625, dual.min = 0.5, dual.max = 1.25;
   dual.bond_min = 0.6875, dual.bond_max = 1.0625, dual.short_bonds = 36, dual.long_bonds = 108;
   r.dual = dual;
+  r.distance_to_input = JobRecord::DistanceToInput{{0.25, 0.75}, 50.0};
   doc = job_to_json(r, "/api/v1", r.created_at + 100);
+  CHECK(doc["distance_to_input"] == json{{"hausdorff", 0.75}, {"relative", 0.015}, {"result_to_input", 0.25},
+                                         {"input_to_result", 0.75}, {"diagonal", 50.0}});
   CHECK(doc["dual"]["atoms"] == 1200);
   CHECK(doc["dual"]["bonds"] == 1800);
   CHECK(doc["dual"]["rings"] == json{{"5", 12}, {"6", 590}});
@@ -199,6 +203,16 @@ TEST_CASE("job document: fields, links only when succeeded, round trip", "[api][
     CHECK(before.thin_parts->vertices_thinner == 0);
     CHECK(before.thin_parts->vertices_thicker == 0);
     CHECK_FALSE(before.thin_parts->sampled);
+  }
+  REQUIRE(back.distance_to_input);
+  CHECK(back.distance_to_input->distance.result_to_input == 0.25);
+  CHECK(back.distance_to_input->distance.input_to_result == 0.75);
+  CHECK(back.distance_to_input->diagonal == 50.0);
+  {
+    // Documents written before the field existed read without it.
+    json old = doc;
+    old.erase("distance_to_input");
+    CHECK_FALSE(job_from_json(old).distance_to_input);
   }
   REQUIRE(back.dual);
   CHECK(back.dual->atoms == 1200);

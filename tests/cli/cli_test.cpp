@@ -15,7 +15,9 @@
 #include <vector>
 
 #include "run_process.h"
+#include "io/mesh_io.h"
 #include "remesh/self_intersections.h"
+#include "remesh/surface_distance.h"
 #include "support/mesh_generators.h"
 
 namespace fs = std::filesystem;
@@ -386,6 +388,17 @@ TEST_CASE("a short remesh run writes the mesh, the dual and one stats row per it
   REQUIRE(r.exit_code == 0);
   CHECK(r.out.find("completed") != std::string::npos);
   CHECK(r.out.find("\n  triangles:            angles ") != std::string::npos);
+  {
+    // How far the result lies from the sphere: the written result against the input, both sides.
+    const std::string key = "\n  distance to input:    ";
+    const auto at = r.out.find(key);
+    REQUIRE(at != std::string::npos);
+    const double printed = std::stod(r.out.substr(at + key.size()));
+    const remesh::SurfaceDistance d =
+        remesh::surface_distance(remesh::read_mesh_file(out).mesh, remesh::test::make_icosphere(2), 1);
+    CHECK(printed == Approx(d.hausdorff()).epsilon(1e-3));  // printed to 4 digits
+    CHECK(printed > 0);
+  }
   const auto j = info_json(out);
   CHECK(j.at("euler") == 2);
   CHECK(j.at("boundary_loops") == 0);

@@ -16,6 +16,8 @@
 #include "api/json_codec.h"
 #include "daemon.h"
 #include "io/mesh_io.h"
+#include "remesh/preconditions.h"
+#include "remesh/surface_distance.h"
 #include "routes.h"
 #include "support/mesh_generators.h"
 
@@ -124,6 +126,23 @@ TEST_CASE("remeshd: submit raw and multipart, follow, download, list, delete", "
   CHECK(dual["bond_interval"][1].get<double>() == Approx(0.35 / std::sqrt(3.0)));
   CHECK(dual["bond_length"]["min"].get<double>() <= dual["bond_length"]["mean"].get<double>());
   CHECK(dual["bonds_inside_fraction"].get<double>() > 0.5);
+  // How far the result lies from the ball: what the remeshed OBJ (exact doubles) and the upload
+  // give, both sides; a ball of radius 1 with edges of 0.2-0.35 sags by about 0.01.
+  {
+    const json& far = done["distance_to_input"];
+    auto result_obj = c.Get(("/api/v1/jobs/" + id + "/result?mesh=remeshed&format=obj").c_str());
+    REQUIRE(result_obj);
+    const remesh::LoadedMesh result = remesh::read_mesh(result_obj->body, {remesh::Format::Obj});
+    const remesh::LoadedMesh ball = remesh::read_mesh(mesh, {remesh::Format::Obj});
+    const remesh::SurfaceDistance d = remesh::surface_distance(result.mesh, ball.mesh, 1);
+    CHECK(far["result_to_input"].get<double>() == Approx(d.result_to_input).epsilon(1e-12));
+    CHECK(far["input_to_result"].get<double>() == Approx(d.input_to_result).epsilon(1e-12));
+    CHECK(far["hausdorff"].get<double>() == std::max(far["result_to_input"].get<double>(), far["input_to_result"].get<double>()));
+    CHECK(far["diagonal"].get<double>() == Approx(remesh::bounding_box_diagonal(ball.mesh)));
+    CHECK(far["relative"].get<double>() == Approx(far["hausdorff"].get<double>() / far["diagonal"].get<double>()));
+    CHECK(far["hausdorff"].get<double>() > 0.001);
+    CHECK(far["hausdorff"].get<double>() < 0.05);
+  }
   // Where the time went: every step of Algorithm 1 took some, none negative, the remeshing call
   // within the job's run, and the steps plus the rest add up to it.
   const json& steps = done["seconds_by_step"];

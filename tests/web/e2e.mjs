@@ -194,6 +194,9 @@ async function main() {
   const both = Boolean(by && by.thinner.vertices > 0 && by.thicker.vertices > 0);
   check(both === / % regular where the input is at least [\d.]+ thick, [\d.]+ % in thinner parts/.test(progress_text),
     `regular vertices by thickness shown exactly when the job document has both kinds (${JSON.stringify(by)})`);
+  const far = job_doc.distance_to_input;
+  check(far && progress_text.includes(`within ${+far.hausdorff.toPrecision(3)} of the input (${+(100 * far.relative).toPrecision(2)} % of its diagonal)`),
+    `the distance to the input shown as the job document has it (${JSON.stringify(far)})`);
   const summary_text = await page.textContent('#summary');
   check(/server summary/.test(summary_text) && /genus/.test(summary_text), 'server summary with genus replaces the local one');
 

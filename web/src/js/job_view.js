@@ -279,6 +279,10 @@ export class JobView {
     if (tri && tri.faces > 0)
       text += ` · angles ${tri.min_angle.toFixed(1)}° to ${tri.max_angle.toFixed(1)}°, ` +
         `${(100 * tri.below_30).toFixed(2)} % of triangles with one under 30°`;
+    // How far the result lies from the input (both sides' largest), against the input's size.
+    const far = job.distance_to_input;
+    if (far && Number.isFinite(far.hausdorff))
+      text += ` · within ${+far.hausdorff.toPrecision(3)} of the input (${+(100 * far.relative).toPrecision(2)} % of its diagonal)`;
     const secs = this.rows.reduce((s, r) => s + (r.seconds || 0), 0);
     if (secs) text += ` · ${secs.toFixed(1)} s`;
     $('progress-text').textContent = text;

@@ -1,7 +1,8 @@
 #pragma once
 /// \file triangle_bvh.h
-/// Exact distance from a point to a triangle mesh, for the benchmark's Hausdorff distance: a
-/// bounding-volume hierarchy (axis-aligned boxes, median splits) over the triangles. The engine's
+/// Not in the thesis: the exact distance from a point to a triangle mesh, for measuring how far a
+/// result lies from its input (surface_distance.h; the benchmark's Hausdorff distance): a
+/// bounding-volume hierarchy (axis-aligned boxes, median splits) over the triangles. The
 /// ReferenceSurface answers from the triangles around the 30 nearest vertices (the thesis'
 /// Algorithm 6), which overestimates the distance where a mesh has long triangles next to dense
 /// ones (nefertiti's base: triangles 20 long beside a rim of short ones): good for projecting,
@@ -12,13 +13,13 @@
 
 #include "core/mesh.h"
 
-namespace remesh::bench {
+namespace remesh {
 
 class TriangleBvh {
  public:
   explicit TriangleBvh(const TriMesh& mesh);
 
-  /// Distance from p to the nearest point of the mesh's triangles.
+  /// Distance from p to the nearest point of the mesh's triangles (infinity without triangles).
   double distance(const Vec3& p) const;
 
  private:
@@ -36,4 +37,4 @@ class TriangleBvh {
   std::vector<Node> nodes_;
 };
 
-}  // namespace remesh::bench
+}  // namespace remesh

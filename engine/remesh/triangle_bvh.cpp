@@ -1,4 +1,4 @@
-#include "triangle_bvh.h"
+#include "remesh/triangle_bvh.h"
 
 #include <algorithm>
 #include <cmath>
@@ -7,7 +7,7 @@
 
 #include "remesh/geometry.h"
 
-namespace remesh::bench {
+namespace remesh {
 
 namespace {
 
@@ -108,4 +108,4 @@ double TriangleBvh::distance(const Vec3& p) const {
   return std::sqrt(best);
 }
 
-}  // namespace remesh::bench
+}  // namespace remesh
