@@ -293,11 +293,15 @@ JobRecord job_from_json(const json& j) {
       job.seconds_by_step = step_seconds_from_json(*t);
     // Absent in documents written before the field existed.
     if (const auto d = j.find("dual"); d != j.end() && !d->is_null()) job.dual = dual_from_json(*d);
-    // Absent in documents written before the field existed.
-    if (const auto d = j.find("distance_to_input"); d != j.end() && !d->is_null())
-      job.distance_to_input = JobRecord::DistanceToInput{
-          {d->at("result_to_input").get<double>(), d->at("input_to_result").get<double>()},
-          d->at("diagonal").get<double>()};
+    // Absent in documents written before the field existed. A side JSON could not hold (infinity
+    // is written as null: a side without triangles) leaves the field out, not the job.
+    if (const auto d = j.find("distance_to_input"); d != j.end() && d->is_object()) {
+      const auto number = [&](const char* name) { return d->contains(name) && d->at(name).is_number(); };
+      if (number("result_to_input") && number("input_to_result") && number("diagonal"))
+        job.distance_to_input = JobRecord::DistanceToInput{
+            {d->at("result_to_input").get<double>(), d->at("input_to_result").get<double>()},
+            d->at("diagonal").get<double>()};
+    }
     if (!j.at("error").is_null()) job.error = j.at("error").get<std::string>();
     job.attempts = j.value("attempts", 0);  // absent in documents written before the field existed
     return job;

@@ -3,9 +3,10 @@
 /// Not in the thesis: how far a result lies from its input, the question "is it still the input's
 /// surface". Both one-sided distances, measured exactly (triangle_bvh.h) from sample points of
 /// each surface to the other's triangles: every vertex, edge midpoint and face centroid. The
-/// largest of them is the Hausdorff distance as far as those points find it: a lower bound, which
-/// a denser sampling raises by little (the midpoints catch a chord that cuts a crease or a tip;
-/// the benchmark's 400 000 points a mesh found at most a few % more on the shared meshes).
+/// largest of them is the Hausdorff distance as far as those points find it: a lower bound (the
+/// midpoints catch a chord that cuts a crease or a tip). Against the benchmark's 400 000 points a
+/// mesh on the shared meshes' 20 runs: the same on nefertiti, up to 9 % lower (spot simplified), and
+/// a dense brute force found spot simplified's 10 % higher.
 
 #include <vector>
 
@@ -28,7 +29,8 @@ std::vector<Vec3> distance_samples(const TriMesh& mesh);
 /// `to` has no triangles), on up to `threads` threads, the same whatever their number.
 double largest_distance(const std::vector<Vec3>& points, const TriangleBvh& to, unsigned threads);
 
-/// Both one-sided distances between `result` and `input` at their distance_samples().
+/// Both one-sided distances between `result` and `input` at their distance_samples(); a side within
+/// 1e-12 of the input's bounding-box diagonal (rounding: a surface against itself) is 0.
 SurfaceDistance surface_distance(const TriMesh& result, const TriMesh& input, unsigned threads);
 
 }  // namespace remesh

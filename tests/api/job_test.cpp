@@ -209,10 +209,17 @@ TEST_CASE("job document: fields, links only when succeeded, round trip", "[api][
   CHECK(back.distance_to_input->distance.input_to_result == 0.75);
   CHECK(back.distance_to_input->diagonal == 50.0);
   {
-    // Documents written before the field existed read without it.
+    // Documents written before the field existed read without it; one with a side JSON wrote as
+    // null (infinity) reads without it too, the job kept.
     json old = doc;
     old.erase("distance_to_input");
     CHECK_FALSE(job_from_json(old).distance_to_input);
+    json infinite = doc;
+    infinite["distance_to_input"]["result_to_input"] = nullptr;
+    JobRecord kept;
+    REQUIRE_NOTHROW(kept = job_from_json(infinite));
+    CHECK(kept.id == r.id);
+    CHECK_FALSE(kept.distance_to_input);
   }
   REQUIRE(back.dual);
   CHECK(back.dual->atoms == 1200);

@@ -43,9 +43,9 @@ TEST_CASE("surface_distance: both sides, on surfaces whose distance is known", "
   const TriMesh sphere = test::make_icosphere(3, 1.0);
   SECTION("a surface is at distance 0 from itself") {
     const SurfaceDistance d = surface_distance(sphere, sphere, 2);
-    // Up to rounding: a midpoint or centroid lies on its face within a few ulps.
-    CHECK(d.result_to_input < 1e-12);
-    CHECK(d.input_to_result < 1e-12);
+    // Exactly 0: a midpoint or centroid lies on its face within rounding, which is taken as 0.
+    CHECK(d.result_to_input == 0);
+    CHECK(d.input_to_result == 0);
   }
   SECTION("a copy 2 % larger: every vertex 0.02 out, the faces nearer") {
     const SurfaceDistance d = surface_distance(scaled(sphere, 1.02), sphere, 2);
@@ -73,15 +73,35 @@ TEST_CASE("surface_distance: both sides, on surfaces whose distance is known", "
     base.add_face(a2, c2, b2);
     base.add_face(a2, e2, c2);
     const SurfaceDistance d = surface_distance(base, pyramid, 2);
-    CHECK(d.result_to_input < 1e-12);
+    CHECK(d.result_to_input == 0);
     CHECK(d.input_to_result == Approx(2.0));
   }
-  SECTION("the same answer with 1 and 2 threads") {
-    const TriMesh torus = test::make_torus(40, 16, 2.0, 0.6), coarse = test::make_torus(12, 6, 2.0, 0.6);
-    const SurfaceDistance one = surface_distance(coarse, torus, 1), two = surface_distance(coarse, torus, 2);
-    CHECK(one.result_to_input == two.result_to_input);
-    CHECK(one.input_to_result == two.input_to_result);
-    CHECK(one.hausdorff() > 0);
+  SECTION("the same answer with 1 and 2 threads, over many blocks of samples") {
+    // 12 800 + 38 400 + 25 600 samples one way, 2 592 the other: dozens of blocks of 1 024.
+    const TriMesh fine = test::make_torus(160, 80, 2.0, 0.6), coarse = test::make_torus(36, 12, 2.0, 0.6);
+    REQUIRE(distance_samples(fine).size() > 40 * 1024);
+    for (const auto& [result, input] : {std::pair{&coarse, &fine}, {&fine, &coarse}}) {
+      const SurfaceDistance one = surface_distance(*result, *input, 1), two = surface_distance(*result, *input, 2);
+      CHECK(one.result_to_input == two.result_to_input);
+      CHECK(one.input_to_result == two.input_to_result);
+      CHECK(one.hausdorff() > 0);
+    }
+  }
+  SECTION("deleted elements are passed over: the same as after garbage collection") {
+    TriMesh torus = test::make_torus(24, 12, 2.0, 0.6);
+    torus.request_face_status();
+    torus.request_edge_status();
+    torus.request_vertex_status();
+    int k = 0;
+    for (auto f : torus.faces())
+      if (k++ % 3 == 0) torus.delete_face(f, true);
+    TriMesh collected = torus;
+    collected.garbage_collection();
+    REQUIRE(collected.n_faces() < torus.n_faces());  // deleted, not yet collected
+    CHECK(distance_samples(torus).size() == distance_samples(collected).size());
+    const SurfaceDistance deleted = surface_distance(torus, sphere, 2), gone = surface_distance(collected, sphere, 2);
+    CHECK(deleted.result_to_input == gone.result_to_input);
+    CHECK(deleted.input_to_result == gone.input_to_result);
   }
 }
 
