@@ -62,13 +62,6 @@ std::string base64(const std::string& in) {
   return out;
 }
 
-/// GLB and glTF state their lengths and offsets in 32 bits (GLB's header and chunks; the index
-/// type UNSIGNED_INT): past that the file would be silently wrong.
-void check_length(std::size_t bytes, const char* format) {
-  if (bytes > std::numeric_limits<std::uint32_t>::max())
-    throw std::range_error(std::string(format) + " cannot hold " + std::to_string(bytes) +
-                           " bytes of vertices and indices: its lengths are 32-bit, at most 4 GiB");
-}
 
 /// The glTF JSON document of `soup` and its binary buffer (`bin`, unpadded). With `embed`, the
 /// buffer is in the document as a base64 data: URI (text .gltf); without, it is the GLB's BIN chunk.
@@ -93,7 +86,7 @@ std::string gltf_document(const PolygonSoup& soup, std::string& bin, bool embed)
   for (std::uint32_t i : tris) put_le<std::uint32_t>(bin, i);
   const std::size_t line_offset = bin.size();
   for (std::uint32_t i : lines) put_le<std::uint32_t>(bin, i);
-  check_length(bin.size(), embed ? "glTF" : "GLB");
+  check_32bit_length(bin.size(), embed ? "glTF" : "GLB");
 
   std::string json = R"({"asset":{"version":"2.0","generator":"remeshd"},"scene":0,)";
   if (soup.points.empty()) {
@@ -128,6 +121,12 @@ std::string gltf_document(const PolygonSoup& soup, std::string& bin, bool embed)
 
 }  // namespace
 
+void check_32bit_length(std::size_t bytes, const char* format) {
+  if (bytes > std::numeric_limits<std::uint32_t>::max())
+    throw std::range_error(std::string(format) + " cannot hold " + std::to_string(bytes) +
+                           " bytes of vertices and indices: its lengths are 32-bit, at most 4 GiB");
+}
+
 std::string write_gltf(const PolygonSoup& soup) {
   check_float32(soup, "glTF");
   std::string bin;
@@ -141,7 +140,7 @@ std::string write_glb(const PolygonSoup& soup) {
   while (json.size() % 4) json += ' ';
   while (bin.size() % 4) bin += '\0';
   const bool has_bin = !bin.empty();
-  check_length(12 + 8 + json.size() + (has_bin ? 8 + bin.size() : 0), "GLB");
+  check_32bit_length(12 + 8 + json.size() + (has_bin ? 8 + bin.size() : 0), "GLB");
   std::string out = "glTF";
   put_le<std::uint32_t>(out, 2);
   put_le<std::uint32_t>(out, static_cast<std::uint32_t>(12 + 8 + json.size() + (has_bin ? 8 + bin.size() : 0)));

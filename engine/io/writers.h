@@ -24,6 +24,10 @@ void append_number(std::string& out, double v);
 /// round to a finite float32 (magnitude about 3.4e38 or more): STL, GLB and glTF store float32.
 void check_float32(const PolygonSoup& soup, const char* format);
 
+/// Throws std::range_error, naming `format`, if `bytes` do not fit the 32-bit lengths and offsets
+/// of GLB and glTF (more than 4 GiB - 1): past that the file would be silently wrong.
+void check_32bit_length(std::size_t bytes, const char* format);
+
 /// Fan triangles of every face: (f0, fi, fi+1).
 template <class F>
 void for_each_fan_triangle(const PolygonSoup& soup, F&& f) {

@@ -15,6 +15,7 @@
 
 #include "io/mesh_io.h"
 #include "io/summary.h"
+#include "io/writers.h"
 #include "io_test_util.h"
 #include "support/mesh_generators.h"
 
@@ -198,6 +199,16 @@ TEST_CASE("Text glTF holds the GLB document, and its BIN chunk in base64") {
   CHECK(empty_json.find("buffers") == std::string::npos);
   CHECK(empty_json.find(R"("scenes":[{}])") != std::string::npos);  // an empty "nodes" is invalid glTF
   CHECK(write_mesh(empty, Format::Gltf) == empty_json + "\n");
+}
+
+TEST_CASE("GLB and glTF refuse what their 32-bit lengths cannot state") {
+  // The guard write_glb and write_gltf call on their buffer and GLB's whole file (a mesh that big
+  // needs more memory than a test has: the bound is checked here).
+  constexpr std::size_t largest = 0xFFFFFFFFu;
+  CHECK_NOTHROW(io::check_32bit_length(largest, "GLB"));
+  CHECK_THROWS_AS(io::check_32bit_length(largest + 1, "GLB"), std::range_error);
+  CHECK_THROWS_WITH(io::check_32bit_length(std::size_t{5} << 30, "glTF"),
+                    "glTF cannot hold 5368709120 bytes of vertices and indices: its lengths are 32-bit, at most 4 GiB");
 }
 
 TEST_CASE("XYZ writes one carbon atom per point") {
