@@ -21,10 +21,22 @@ ParsedParams good_params() {
   return params_from_json(nlohmann::json{{"emin", 0.2}, {"emax", 0.4}, {"iterations", 3}});
 }
 
-std::set<std::string> fields_of(const ParamsError& e) {
+std::set<std::string> fields_of(const std::vector<FieldError>& errors) {
   std::set<std::string> s;
-  for (const auto& f : e.errors()) s.insert(f.field);
+  for (const auto& f : errors) s.insert(f.field);
   return s;
+}
+
+/// The field errors prepare_job refuses `bytes` (an OBJ) and `params` with; a failed check when it
+/// takes them.
+std::vector<FieldError> refusal(std::string_view bytes, const ParsedParams& params, const UploadLimits& limits = {}) {
+  try {
+    prepare_job(bytes, "x.obj", Format::Obj, params, limits);
+  } catch (const ParamsError& e) {
+    return e.errors();
+  }
+  FAIL("no ParamsError");
+  return {};
 }
 
 }  // namespace
@@ -106,41 +118,25 @@ TEST_CASE("prepare_job: the errors it must give", "[api][upload]") {
   auto params = [](nlohmann::json j) { return params_from_json(j); };
 
   SECTION("every bad parameter, before the mesh is read") {
-    try {
-      prepare_job("not a mesh", "x.obj", Format::Obj,
-                  params({{"emin", -1}, {"emax", 0.4}, {"rings", 9}, {"iterations", "x"}}), {});
-      FAIL("no ParamsError");
-    } catch (const ParamsError& e) {
-      CHECK(fields_of(e) == std::set<std::string>{"emin", "rings", "iterations"});
-    }
-    try {
-      prepare_job(obj, "x.obj", Format::Obj, params({{"emin", 0.5}, {"emax", 0.4}}), {});
-      FAIL("no ParamsError");
-    } catch (const ParamsError& e) {
-      CHECK_FALSE(e.errors().empty());
-    }
+    CHECK(fields_of(refusal("not a mesh", params({{"emin", -1}, {"emax", 0.4}, {"rings", 9}, {"iterations", "x"}}))) ==
+          std::set<std::string>{"emin", "rings", "iterations"});
+    CHECK_FALSE(refusal(obj, params({{"emin", 0.5}, {"emax", 0.4}})).empty());
   }
   SECTION("an emin no edge of the mesh can reach (its bounding-box diagonal is about 3.5)") {
-    try {
-      prepare_job(obj, "x.obj", Format::Obj, params({{"emin", 5}, {"emax", 1e300}}), {});
-      FAIL("no ParamsError");
-    } catch (const ParamsError& e) {
-      CHECK(fields_of(e) == std::set<std::string>{"emin"});
-      CHECK(std::string(e.errors().front().message).find("bounding-box diagonal") != std::string::npos);
-    }
+    const std::vector<FieldError> errors = refusal(obj, params({{"emin", 5}, {"emax", 1e300}}));
+    CHECK(fields_of(errors) == std::set<std::string>{"emin"});
+    REQUIRE_FALSE(errors.empty());
+    CHECK(errors.front().message.find("bounding-box diagonal") != std::string::npos);
     CHECK_NOTHROW(prepare_job(obj, "x.obj", Format::Obj, params({{"emin", 0.2}, {"emax", 1e300}}), {}));
   }
   SECTION("a bond_min whose edges no part of the mesh can hold, said in bonds") {
     // bond_min 2.5 asks for edges of 4.33, past the diagonal of about 3.5; the bound is 3.5 / sqrt(3).
-    try {
-      prepare_job(obj, "x.obj", Format::Obj, params({{"bond_min", 2.5}, {"bond_max", 3}}), {});
-      FAIL("no ParamsError");
-    } catch (const ParamsError& e) {
-      CHECK(fields_of(e) == std::set<std::string>{"bond_min"});
-      const std::string message = e.errors().front().message;
-      CHECK_THAT(message, Catch::Contains("diagonal / sqrt(3)"));
-      CHECK_THAT(message, !Catch::Contains("emin"));
-    }
+    const std::vector<FieldError> errors = refusal(obj, params({{"bond_min", 2.5}, {"bond_max", 3}}));
+    CHECK(fields_of(errors) == std::set<std::string>{"bond_min"});
+    REQUIRE_FALSE(errors.empty());
+    const std::string message = errors.front().message;
+    CHECK_THAT(message, Catch::Contains("diagonal / sqrt(3)"));
+    CHECK_THAT(message, !Catch::Contains("emin"));
     const PreparedJob ok = prepare_job(obj, "x.obj", Format::Obj, params({{"bond_min", 0.12}, {"bond_max", 0.2}}), {});
     CHECK(ok.record.params.e_min == Approx(0.12 * std::sqrt(3.0)));
     CHECK(ok.record.params.e_max == Approx(0.2 * std::sqrt(3.0)));
@@ -152,12 +148,7 @@ TEST_CASE("prepare_job: the errors it must give", "[api][upload]") {
   SECTION("iterations over the service limit") {
     UploadLimits limits;
     limits.max_iterations = 2;
-    try {
-      prepare_job(obj, "x.obj", Format::Obj, good_params(), limits);
-      FAIL("no ParamsError");
-    } catch (const ParamsError& e) {
-      CHECK(fields_of(e) == std::set<std::string>{"iterations"});
-    }
+    CHECK(fields_of(refusal(obj, good_params(), limits)) == std::set<std::string>{"iterations"});
   }
   SECTION("unreadable meshes give the reader's message") {
     CHECK_THROWS_AS(prepare_job("v 0 0 0\nf 1 2 3\n", "x.obj", Format::Obj, good_params(), {}), MeshError);
