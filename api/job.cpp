@@ -63,14 +63,12 @@ json format_links(const std::string& base, const std::string& mesh, const std::v
   return links;
 }
 
-/// {hausdorff, relative, result_to_input, input_to_result, diagonal}: relative = hausdorff / diagonal
-/// (0 for a point-sized input).
-json distance_to_json(const JobRecord::DistanceToInput& d) {
-  const double h = d.distance.hausdorff();
-  return {{"hausdorff", h},
-          {"relative", d.diagonal > 0 ? h / d.diagonal : 0.0},
-          {"result_to_input", d.distance.result_to_input},
-          {"input_to_result", d.distance.input_to_result},
+/// {hausdorff, relative, result_to_input, input_to_result, diagonal} (SurfaceDistance).
+json distance_to_json(const SurfaceDistance& d) {
+  return {{"hausdorff", d.hausdorff()},
+          {"relative", d.relative()},
+          {"result_to_input", d.result_to_input},
+          {"input_to_result", d.input_to_result},
           {"diagonal", d.diagonal}};
 }
 
@@ -298,9 +296,8 @@ JobRecord job_from_json(const json& j) {
     if (const auto d = j.find("distance_to_input"); d != j.end() && d->is_object()) {
       const auto number = [&](const char* name) { return d->contains(name) && d->at(name).is_number(); };
       if (number("result_to_input") && number("input_to_result") && number("diagonal"))
-        job.distance_to_input = JobRecord::DistanceToInput{
-            {d->at("result_to_input").get<double>(), d->at("input_to_result").get<double>()},
-            d->at("diagonal").get<double>()};
+        job.distance_to_input = SurfaceDistance{d->at("result_to_input").get<double>(),
+                                                d->at("input_to_result").get<double>(), d->at("diagonal").get<double>()};
     }
     if (!j.at("error").is_null()) job.error = j.at("error").get<std::string>();
     job.attempts = j.value("attempts", 0);  // absent in documents written before the field existed

@@ -71,13 +71,9 @@ struct JobRecord {
   /// Of the result's trivalent dual as an atom lattice (dual/dual_stats.h), its bonds judged
   /// against [e_min, e_max] / sqrt(3); nullopt until the job succeeded.
   std::optional<DualStats> dual;
-  /// How far the result lies from the input (remesh/surface_distance.h), and the input's
-  /// bounding-box diagonal; nullopt until the job succeeded.
-  struct DistanceToInput {
-    SurfaceDistance distance;
-    double diagonal = 0;
-  };
-  std::optional<DistanceToInput> distance_to_input;
+  /// How far the result lies from the input (remesh/surface_distance.h); nullopt until the job
+  /// succeeded.
+  std::optional<SurfaceDistance> distance_to_input;
   std::optional<std::string> error;
   /// Runs started. Counted when a run starts and taken back when a shutdown is asked for (stored
   /// then, before the run stops: a kill during the grace period does not count it); a run the

@@ -247,8 +247,8 @@ double print_quality(const char* who, const TriMesh& input, const TriMesh& outpu
   const SurfaceDistance d = surface_distance(output, input, o.threads);
   std::printf("%-5s: distance to input (vertices, edge midpoints, face centres): %.4f %% of bbox diagonal "
               "(result to input %.4f %%, input to result %.4f %%), %.3fx the Hausdorff above\n",
-              who, 100 * d.hausdorff() / bench::bbox_diagonal(input), 100 * d.result_to_input / bench::bbox_diagonal(input),
-              100 * d.input_to_result / bench::bbox_diagonal(input), h > 0 ? d.hausdorff() / bench::bbox_diagonal(input) / h : 1.0);
+              who, 100 * d.relative(), 100 * d.result_to_input / d.diagonal, 100 * d.input_to_result / d.diagonal,
+              h > 0 ? d.relative() / h : 1.0);
   return 100 * h;
 }
 

@@ -185,15 +185,9 @@ void write_text_file(const std::string& path, const std::string& text) {
 /// too many of its faces overlap to count them, for the summary's crossing line beside the result's.
 using InputCrossings = std::optional<std::size_t>;
 
-/// How far the result lies from the input (surface_distance.h), and the input's bbox diagonal.
-struct InputDistance {
-  SurfaceDistance distance;
-  double diagonal = 0;
-};
-
 void print_final(const TriMesh& mesh, const Job& job, const Result& result, const std::optional<DualStats>& dual,
                  const std::optional<BondRelaxation>& relaxed, const InputCrossings& input_crossings,
-                 const std::optional<InputDistance>& to_input) {
+                 const std::optional<SurfaceDistance>& to_input) {
   const IterationStats q = measure(mesh, job.params.e_min, job.params.e_max, job.params.threads);
   const MeshSummary s = summarize(mesh);
   std::printf("result: %zu vertices, %zu edges, %zu faces\n", s.vertices, s.edges, s.faces);
@@ -241,12 +235,11 @@ void print_final(const TriMesh& mesh, const Job& job, const Result& result, cons
   }
   std::printf("  edge length:          mean %.6g, deviation %.4g, min %.6g, max %.6g\n", q.mean, q.deviation,
               s.min_edge, s.max_edge);
-  if (to_input && to_input->diagonal > 0) {
-    const SurfaceDistance& d = to_input->distance;
+  if (const auto& d = to_input; d && d->diagonal > 0) {
     std::printf("  distance to input:    %.4g at most (%.3g %% of its bounding-box diagonal): the result lies within "
                 "%.4g of the input, the input within %.4g of the result (at vertices, edge midpoints and face "
                 "centres)\n",
-                d.hausdorff(), 100.0 * d.hausdorff() / to_input->diagonal, d.result_to_input, d.input_to_result);
+                d->hausdorff(), 100.0 * d->relative(), d->result_to_input, d->input_to_result);
   }
   if (const auto& t = result.triangles; t && t->faces > 0)
     std::printf("  triangles:            angles %.1f to %.1f degrees, %.3f %% with one under 30, %.3f %% obtuse; "
@@ -345,12 +338,12 @@ int run_remesh(const std::vector<std::string>& args) {
   }
   if (!job.quiet) {
     // Not after Ctrl-C: the user wants out (nefertiti at 831 000 faces: 2 s more to exit).
-    std::optional<InputDistance> to_input;
+    std::optional<SurfaceDistance> to_input;
     if (!stop.stop_requested()) {
       TriMesh input;
       input_kept->rebuild(input);
       input_kept.reset();
-      to_input = InputDistance{surface_distance(mesh, input, job.params.threads), bounding_box_diagonal(input)};
+      to_input = surface_distance(mesh, input, job.params.threads);
     }
     print_final(mesh, job, result, dual_summary, relaxed, input_crossings, to_input);
   }

@@ -8,7 +8,6 @@
 #include "dual/trivalent_dual.h"
 #include "io/mesh_io.h"
 #include "remesh/mesh_snapshot.h"
-#include "remesh/preconditions.h"
 #include "remesh/reference_surface.h"
 #include "remesh/surface_distance.h"
 
@@ -79,8 +78,7 @@ RunOutput run_job(const remesh::api::JobRecord& job, std::string upload, unsigne
   const remesh::ReferenceSurface reference = [&] {
     remesh::TriMesh input_mesh;
     input.rebuild(input_mesh);
-    out.distance = {remesh::surface_distance(mesh, input_mesh, params.threads),
-                    remesh::bounding_box_diagonal(input_mesh)};
+    out.distance = remesh::surface_distance(mesh, input_mesh, params.threads);
     return remesh::ReferenceSurface(input_mesh);
   }();
   remesh::PolyMesh dual = remesh::trivalent_dual(mesh, &reference);

@@ -22,8 +22,8 @@ struct RunOutput {
   remesh::DualStats dual;  ///< the dual's, against [e_min, e_max] / sqrt(3) (not when cancelled)
   /// The result files its formats cannot hold ("remeshed.stl": float32 past 3.4e38), not written.
   std::vector<std::string> unwritable;
-  /// How far the result lies from the input, and the input's diagonal (not when cancelled).
-  remesh::api::JobRecord::DistanceToInput distance;
+  /// How far the result lies from the input (not when cancelled).
+  remesh::SurfaceDistance distance;
 };
 
 /// Receives each result file as soon as it is serialised: its name ("remeshed.obj", "dual.glb",

@@ -62,7 +62,6 @@ std::string base64(const std::string& in) {
   return out;
 }
 
-
 /// The glTF JSON document of `soup` and its binary buffer (`bin`, unpadded). With `embed`, the
 /// buffer is in the document as a base64 data: URI (text .gltf); without, it is the GLB's BIN chunk.
 std::string gltf_document(const PolygonSoup& soup, std::string& bin, bool embed) {
@@ -140,10 +139,11 @@ std::string write_glb(const PolygonSoup& soup) {
   while (json.size() % 4) json += ' ';
   while (bin.size() % 4) bin += '\0';
   const bool has_bin = !bin.empty();
-  check_32bit_length(12 + 8 + json.size() + (has_bin ? 8 + bin.size() : 0), "GLB");
+  const std::size_t total = 12 + 8 + json.size() + (has_bin ? 8 + bin.size() : 0);
+  check_32bit_length(total, "GLB");
   std::string out = "glTF";
   put_le<std::uint32_t>(out, 2);
-  put_le<std::uint32_t>(out, static_cast<std::uint32_t>(12 + 8 + json.size() + (has_bin ? 8 + bin.size() : 0)));
+  put_le<std::uint32_t>(out, static_cast<std::uint32_t>(total));
   put_le<std::uint32_t>(out, static_cast<std::uint32_t>(json.size()));
   out += "JSON";
   out += json;

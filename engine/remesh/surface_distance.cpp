@@ -42,8 +42,9 @@ SurfaceDistance surface_distance(const TriMesh& result, const TriMesh& input, un
   SurfaceDistance d;
   d.result_to_input = largest_distance(distance_samples(result), TriangleBvh(input), threads);
   d.input_to_result = largest_distance(distance_samples(input), TriangleBvh(result), threads);
+  d.diagonal = bounding_box_diagonal(input);
   // A midpoint or centroid lies on its own face within rounding (1e-16 of the size): that is 0.
-  const double noise = 1e-12 * bounding_box_diagonal(input);
+  const double noise = 1e-12 * d.diagonal;
   for (double* side : {&d.result_to_input, &d.input_to_result})
     if (*side <= noise) *side = 0;
   return d;

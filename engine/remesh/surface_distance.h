@@ -19,7 +19,10 @@ namespace remesh {
 struct SurfaceDistance {
   double result_to_input = 0;  ///< the largest distance from a sample of the result to the input
   double input_to_result = 0;  ///< the largest distance from a sample of the input to the result
+  double diagonal = 0;         ///< the input's bounding-box diagonal, the scale of the two
   double hausdorff() const { return result_to_input > input_to_result ? result_to_input : input_to_result; }
+  /// hausdorff() over the diagonal (0 for a point-sized input).
+  double relative() const { return diagonal > 0 ? hausdorff() / diagonal : 0.0; }
 };
 
 /// The points a surface's distance is measured at: its vertices, edge midpoints and face centroids

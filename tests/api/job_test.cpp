@@ -96,7 +96,7 @@ TEST_CASE("job document: fields, links only when succeeded, round trip", "[api][
   dual.mean = 0.875, dual.deviation = 0.0625, dual.min = 0.5, dual.max = 1.25;
   dual.bond_min = 0.6875, dual.bond_max = 1.0625, dual.short_bonds = 36, dual.long_bonds = 108;
   r.dual = dual;
-  r.distance_to_input = JobRecord::DistanceToInput{{0.25, 0.75}, 50.0};
+  r.distance_to_input = SurfaceDistance{0.25, 0.75, 50.0};
   doc = job_to_json(r, "/api/v1", r.created_at + 100);
   CHECK(doc["distance_to_input"] == json{{"hausdorff", 0.75}, {"relative", 0.015}, {"result_to_input", 0.25},
                                          {"input_to_result", 0.75}, {"diagonal", 50.0}});
@@ -205,8 +205,8 @@ TEST_CASE("job document: fields, links only when succeeded, round trip", "[api][
     CHECK_FALSE(before.thin_parts->sampled);
   }
   REQUIRE(back.distance_to_input);
-  CHECK(back.distance_to_input->distance.result_to_input == 0.25);
-  CHECK(back.distance_to_input->distance.input_to_result == 0.75);
+  CHECK(back.distance_to_input->result_to_input == 0.25);
+  CHECK(back.distance_to_input->input_to_result == 0.75);
   CHECK(back.distance_to_input->diagonal == 50.0);
   {
     // Documents written before the field existed read without it; one with a side JSON wrote as

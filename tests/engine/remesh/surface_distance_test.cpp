@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "remesh/geometry.h"
+#include "remesh/preconditions.h"
 #include "remesh/surface_distance.h"
 #include "remesh/triangle_bvh.h"
 #include "support/mesh_generators.h"
@@ -56,6 +57,9 @@ TEST_CASE("surface_distance: both sides, on surfaces whose distance is known", "
     CHECK(d.input_to_result > 0.005);
     CHECK(d.input_to_result <= 0.02 + 1e-12);
     CHECK(d.hausdorff() == std::max(d.result_to_input, d.input_to_result));
+    // Its scale: the input's bounding-box diagonal (a unit sphere's: 2 sqrt(3) at most).
+    CHECK(d.diagonal == bounding_box_diagonal(sphere));
+    CHECK(d.relative() == d.hausdorff() / d.diagonal);
   }
   SECTION("one-sided: a tip the result cuts off counts from the input only") {
     // The input: a unit square pyramid of height 2; the result: its base square alone, which lies
