@@ -112,15 +112,6 @@ Topology topology_of(const TriMesh& mesh) {
   return t;
 }
 
-double bbox_diagonal(const TriMesh& mesh) {
-  Vec3 lo(1e300, 1e300, 1e300), hi(-1e300, -1e300, -1e300);
-  for (auto v : mesh.vertices()) {
-    lo.minimize(mesh.point(v));
-    hi.maximize(mesh.point(v));
-  }
-  return (hi - lo).norm();
-}
-
 namespace {
 
 /// Largest distance from the samples of `from` to the surface `to`.

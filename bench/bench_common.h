@@ -32,9 +32,6 @@ struct Topology {
 };
 Topology topology_of(const TriMesh& mesh);
 
-/// Length of the bounding-box diagonal.
-double bbox_diagonal(const TriMesh& mesh);
-
 /// Symmetric Hausdorff distance between a and b, estimated by sampling: every vertex plus about
 /// `samples` points spread over the faces by area (barycentric grid per face), each measured
 /// exactly against the other mesh's triangles (triangle_bvh.h); the larger of the two one-sided

@@ -39,6 +39,7 @@
 #include "core/parallel.h"
 #include "remesh/equalize.h"
 #include "remesh/geometry.h"
+#include "remesh/preconditions.h"
 #include "remesh/reference_surface.h"
 #include "remesh/self_intersections.h"
 #include "remesh/surface_distance.h"
@@ -225,7 +226,7 @@ double print_quality(const char* who, const TriMesh& input, const TriMesh& outpu
                    std::size_t crossings_in, const ChildResult& r, const Options& o) {
   const IterationStats s = measure(output, kEmin, kEmax, o.threads);
   const bench::Topology t = bench::topology_of(output);
-  const double h = bench::hausdorff_distance(input, output, o.samples, o.threads) / bench::bbox_diagonal(input);
+  const double h = bench::hausdorff_distance(input, output, o.samples, o.threads) / bounding_box_diagonal(input);
   std::printf("%-5s: inside %.3f %% (small %zu, big %zu), regular %.2f %%, mean %.4f, dev %.4f, V %zu, F %zu, "
               "Hausdorff %.4f %% of bbox diagonal, %d it (%s), %.4f s/it, total %.3f s, peak %.1f MiB, "
               "topology %s (euler %ld, boundary loops %zu, components %zu), crossing face pairs %zu (input %zu)\n",
@@ -296,7 +297,7 @@ void run_spread(const std::string& name, const std::string& scaled, const TriMes
   double inside_sum = 0, inside_min = 100, regular_sum = 0, regular_min = 100, h_sum = 0, h_max = 0, seconds = 0;
   std::size_t crossings = 0;
   int runs = 0;
-  const double diagonal = bench::bbox_diagonal(input);
+  const double diagonal = bounding_box_diagonal(input);
   for (const auto& [e_min, e_max] : kSpread) {
     const bool standard = e_min == kEmin && e_max == kEmax;
     const std::string out = standard ? (dir / (name + "_ours.off")).string()
