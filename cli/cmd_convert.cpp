@@ -1,5 +1,5 @@
 /// \file cmd_convert.cpp
-/// `remesh convert IN OUT [--weld]`: read (validate, repair), write in the format of OUT's extension.
+/// `remesh convert IN OUT [--weld] [--quiet]`: read (validate, repair), write in the format of OUT's extension.
 
 #include <iostream>
 
@@ -18,7 +18,7 @@ const std::vector<OptionSpec> kSpec = {
 
 int run_convert(const std::vector<std::string>& args) {
   if (wants_help(args)) {
-    std::cout << format_help("remesh convert IN OUT [--weld]",
+    std::cout << format_help("remesh convert IN OUT [--weld] [--quiet]",
                              "Reads IN (obj, off, ply, stl, gltf, glb), repairs it as 'remesh info' reports,\n"
                              "and writes OUT in the format of its extension: .obj, .off, .ply (binary),\n"
                              ".stl (binary), .glb (binary glTF), .gltf (text glTF, its buffer inside as\n"

@@ -596,6 +596,25 @@ TEST_CASE("remeshd: api/openapi.yaml documents every job parameter the codec rea
   }
 }
 
+TEST_CASE("remeshd: api/openapi.yaml lists the content type of every download format", "[server][openapi]") {
+  // The result route's answers: each format's MIME type (without its parameters) as a content key.
+  std::ifstream in(REMESHD_OPENAPI);
+  REQUIRE(in);
+  const std::string yaml((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::size_t route = yaml.find("\n  /api/v1/jobs/{id}/result:");
+  REQUIRE(route != std::string::npos);
+  const std::size_t end = yaml.find("\n  /", route + 1);
+  const std::string section = yaml.substr(route, end - route);
+  using remesh::Format;
+  for (Format f : {Format::Obj, Format::Off, Format::Ply, Format::Stl, Format::Gltf, Format::Glb, Format::Xyz,
+                   Format::Lammps}) {
+    const std::string_view mime = remesh::mime_type(f);
+    const std::string type(mime.substr(0, mime.find(';')));
+    INFO(type);
+    CHECK(section.find("\n            " + type + ":") != std::string::npos);
+  }
+}
+
 TEST_CASE("remeshd: the routes in api/openapi.yaml are the routes the server serves", "[server][openapi]") {
   // Routes of the spec: "  /path:" then "    get:" etc.
   std::ifstream in(REMESHD_OPENAPI);
