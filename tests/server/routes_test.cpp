@@ -35,6 +35,13 @@ std::set<std::string> error_fields(const httplib::Result& r) {
   return s;
 }
 
+/// The text of api/openapi.yaml in the source tree.
+std::string openapi_yaml() {
+  std::ifstream in(REMESHD_OPENAPI);
+  REQUIRE(in);
+  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+}
+
 }  // namespace
 
 TEST_CASE("remeshd: submit raw and multipart, follow, download, list, delete", "[server]") {
@@ -578,9 +585,7 @@ TEST_CASE("remeshd: the errors each route must give", "[server]") {
 TEST_CASE("remeshd: api/openapi.yaml documents every job parameter the codec reads and echoes", "[server][openapi]") {
   // The names come from the codec itself: the echo of a job's params (to_json) plus the read option
   // weld. Each must be a query parameter of POST /jobs and a property of ParamsInput.
-  std::ifstream in(REMESHD_OPENAPI);
-  REQUIRE(in);
-  const std::string yaml((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string yaml = openapi_yaml();
   const std::size_t input = yaml.find("    ParamsInput:");
   REQUIRE(input != std::string::npos);
   const std::string params_input = yaml.substr(input, yaml.find("\n    IterationStats:", input) - input);
@@ -598,9 +603,7 @@ TEST_CASE("remeshd: api/openapi.yaml documents every job parameter the codec rea
 
 TEST_CASE("remeshd: api/openapi.yaml lists the content type of every download format", "[server][openapi]") {
   // The result route's answers: each format's MIME type (without its parameters) as a content key.
-  std::ifstream in(REMESHD_OPENAPI);
-  REQUIRE(in);
-  const std::string yaml((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string yaml = openapi_yaml();
   const std::size_t route = yaml.find("\n  /api/v1/jobs/{id}/result:");
   REQUIRE(route != std::string::npos);
   const std::size_t end = yaml.find("\n  /", route + 1);
@@ -617,8 +620,7 @@ TEST_CASE("remeshd: api/openapi.yaml lists the content type of every download fo
 
 TEST_CASE("remeshd: the routes in api/openapi.yaml are the routes the server serves", "[server][openapi]") {
   // Routes of the spec: "  /path:" then "    get:" etc.
-  std::ifstream in(REMESHD_OPENAPI);
-  REQUIRE(in);
+  std::istringstream in(openapi_yaml());
   std::set<std::pair<std::string, std::string>> spec;
   std::string line, current;
   bool in_paths = false;
