@@ -18,6 +18,7 @@
 #include "api/json_codec.h"
 #include "api/problem.h"
 #include "api/upload.h"
+#include "connection_server.h"
 #include "io/mesh_io.h"
 #include "routes.h"
 #include "sse.h"
@@ -299,23 +300,13 @@ std::map<std::string, std::string> query_params(const httplib::Request& req) {
 
 }  // namespace
 
-/// httplib::Server with a larger accept backlog: 0.11.4 listens with a backlog of 5, so a burst of
-/// connections (a page opening several streams, many clients) waits for SYN retransmits (1 s+).
-class BackloggedServer : public httplib::Server {
- public:
-  void widen_backlog() {
-    socket_t s = svr_sock_;
-    if (s != INVALID_SOCKET) ::listen(s, SOMAXCONN);
-  }
-};
-
 struct HttpServer::Impl {
   Options options;
   JobManager& jobs;
   Metrics& metrics;
   Logger& log;
   std::filesystem::path web_root;
-  BackloggedServer server;
+  ConnectionServer server;
   std::atomic<std::size_t> streams{0};
   std::vector<std::pair<std::regex, std::string>> route_labels;
   std::chrono::steady_clock::time_point started = std::chrono::steady_clock::now();
