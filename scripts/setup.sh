@@ -15,10 +15,10 @@ JOBS=${REMESH_JOBS:-$(nproc)}
 
 # What building and running needs, and what only the tests need.
 BUILD_PACKAGES=(g++ cmake ninja-build pkg-config ca-certificates
-  libcpp-httplib-dev nlohmann-json3-dev libopenmesh-dev libnanoflann-dev libtinygltf-dev catch2)
+  libcpp-httplib-dev zlib1g-dev libbrotli-dev nlohmann-json3-dev libopenmesh-dev libnanoflann-dev libtinygltf-dev catch2)
 TEST_PACKAGES=(chromium curl)
 # What the built remeshd needs at run time (the Dockerfile's final stage).
-RUNTIME_PACKAGES=(libopenmesh1 libtinygltf2d libcpp-httplib0.11 curl ca-certificates)
+RUNTIME_PACKAGES=(libopenmesh1 libtinygltf2d libcpp-httplib0.11 zlib1g libbrotli1 curl ca-certificates)
 
 log() { printf '[setup] %s\n' "$*" >&2; }
 

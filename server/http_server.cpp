@@ -18,6 +18,7 @@
 #include "api/json_codec.h"
 #include "api/problem.h"
 #include "api/upload.h"
+#include "body_decoder.h"
 #include "connection_server.h"
 #include "io/mesh_io.h"
 #include "routes.h"
@@ -93,6 +94,10 @@ thread_local bool t_pre_routed = false;
 /// Bytes an event stream wrote on this thread for the current request (the access log's `bytes`:
 /// a chunked answer has no length of its own, and every stream was logged with bytes=0).
 thread_local std::size_t t_streamed_bytes = 0;
+/// The Content-Encoding of the current request's raw (not multipart) body, taken out of its
+/// headers by the pre-routing handler so that httplib passes the coded bytes on: the upload
+/// decodes them itself and checks that the stream ended (body_decoder.h). Empty: not coded.
+thread_local std::string t_body_coding;
 
 double seconds_since(std::chrono::steady_clock::time_point t) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
@@ -580,6 +585,7 @@ httplib::Server::HandlerResponse HttpServer::Impl::pre_route(const httplib::Requ
   t_request_start = std::chrono::steady_clock::now();
   t_pre_routed = true;
   t_streamed_bytes = 0;
+  t_body_coding.clear();
   // The query as sent, before anything reads a parameter (the token included), and the byte range
   // taken for the handler to apply (t_range), so that httplib applies none. The request object is
   // httplib's own, not const; only its parsed parameters and ranges change.
@@ -680,7 +686,8 @@ httplib::Server::HandlerResponse HttpServer::Impl::pre_route(const httplib::Requ
     }
     auto& headers = const_cast<httplib::Request&>(req).headers;
     headers.erase("Content-Encoding");
-    if (known) headers.emplace("Content-Encoding", codings[0]);
+    if (known && !req.is_multipart_form_data()) t_body_coding = codings[0];
+    else if (known) headers.emplace("Content-Encoding", codings[0]);  // decoded by httplib, before its parts
   }
   // cpp-httplib 0.11 reads no body for GET, HEAD and OPTIONS: the bytes of one would be read as the
   // next request on the connection (review: GET /healthz with a body that was 'GET /metrics' served
@@ -866,11 +873,18 @@ void HttpServer::Impl::post_job(const httplib::Request& req, httplib::Response& 
           return true;
         });
   } else {
-    ok = reader([&](const char* data, std::size_t n) {
+    auto keep = [&](const char* data, std::size_t n) {
       if (!count(n)) return false;
       if (!too_big) body.append(data, n);
       return true;
-    });
+    };
+    if (t_body_coding.empty()) {
+      ok = reader(keep);
+    } else {
+      BodyDecoder decoder(t_body_coding);
+      ok = reader([&](const char* data, std::size_t n) { return decoder.feed(data, n, keep); });
+      if (ok && !too_big && !decoder.complete()) ok = false;  // cut off
+    }
     filename = req.get_param_value("filename");
     part_type = req.get_header_value("Content-Type");
   }
@@ -885,9 +899,11 @@ void HttpServer::Impl::post_job(const httplib::Request& req, httplib::Response& 
     if (req.is_multipart_form_data() && b != std::string::npos && type.find(';', b) != std::string::npos)
       send_problem(res, 400, "multipart/form-data: nothing may follow the boundary parameter (drop '" +
                                  type.substr(type.find(';', b)).substr(0, 40) + "')");
-    else if (req.has_header("Content-Encoding"))
+    else if (!t_body_coding.empty() || req.has_header("Content-Encoding"))
       send_problem(res, 400, "the request body could not be decoded as Content-Encoding '" +
-                                 req.get_header_value("Content-Encoding").substr(0, 40) + "' (or it was cut off)");
+                                 (t_body_coding.empty() ? req.get_header_value("Content-Encoding").substr(0, 40)
+                                                        : t_body_coding) +
+                                 "' (or it was cut off)");
     else
       send_problem(res, 400, "the request body could not be read (malformed or interrupted upload)");
     return;
