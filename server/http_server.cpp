@@ -21,6 +21,7 @@
 #include "body_decoder.h"
 #include "connection_server.h"
 #include "io/mesh_io.h"
+#include "open_file.h"
 #include "routes.h"
 #include "sse.h"
 #include "static_files.h"
@@ -64,6 +65,8 @@ void provide(httplib::Response& res, std::string bytes, const std::string& mime)
 
 constexpr const char* kPrefix = "/api/v1";
 constexpr std::size_t kMiB = 1024 * 1024;
+/// What a download reads from its file at a time.
+constexpr std::size_t kPiece = 64 * 1024;
 /// Uploads from this size on have the memory they took handed back to the system after their answer.
 constexpr std::size_t kTrimAfterBytes = 8 * kMiB;
 /// An upload of this size or more (its bytes as decoded) waits for a slot of the upload gate
@@ -131,13 +134,14 @@ void send_unsatisfiable(const httplib::Request& req, httplib::Response& res, std
   res.set_header("Content-Range", "bytes */" + std::to_string(size));
 }
 
-/// `bytes` as a 200, or the range of them the request asks for (t_range): a 206 with Content-Range
-/// "bytes first-last/size", the last byte clamped to the size; a 416 with "bytes */size" when it
-/// starts past the end, asks for the last 0 bytes or is malformed. A range goes out uncompressed (Content-Range
-/// counts the bytes as they are); a whole answer as set_content() if `compress`, else provided.
-void send_ranged(const httplib::Request& req, httplib::Response& res, std::string bytes, const std::string& mime,
-                 bool compress) {
-  const std::size_t size = bytes.size();
+/// The bytes of an answer of `size` bytes that go out: all of them with a 200, or the range the
+/// request asks for (t_range): a 206 with Content-Range "bytes first-last/size", the last byte
+/// clamped to the size. Nothing, with a 416 and "bytes */size" set, when the range starts past the
+/// end, asks for the last 0 bytes or is malformed.
+struct Span {
+  std::size_t begin = 0, length = 0;
+};
+std::optional<Span> answer_span(const httplib::Request& req, httplib::Response& res, std::size_t size) {
   // If-Range (RFC 9110 13.1.5): the range only if the answer is still the one the client has (the
   // ETag it names, compared strongly); else the whole answer. It was ignored: a 206 of a changed file.
   if (t_range && req.has_header("If-Range") &&
@@ -146,9 +150,7 @@ void send_ranged(const httplib::Request& req, httplib::Response& res, std::strin
     t_range.reset();
   if (!t_range) {
     res.status = 200;
-    if (compress) res.set_content(std::move(bytes), mime);
-    else provide(res, std::move(bytes), mime);
-    return;
+    return Span{0, size};
   }
   // httplib's parsed range: -1 for a position not given ("500-": to the end, "-500": the last 500).
   const auto [first, last] = *t_range;
@@ -160,17 +162,48 @@ void send_ranged(const httplib::Request& req, httplib::Response& res, std::strin
     begin = size - std::min(static_cast<std::size_t>(last), size);
     end = size - 1;
   } else {
-    return send_unsatisfiable(req, res, size);
+    send_unsatisfiable(req, res, size);
+    return std::nullopt;
   }
   res.status = 206;
   res.set_header("Content-Range",
                  "bytes " + std::to_string(begin) + "-" + std::to_string(end) + "/" + std::to_string(size));
-  provide(res, bytes.substr(begin, end - begin + 1), mime);
+  return Span{begin, end - begin + 1};
 }
 
-/// A file's bytes as the answer (whole or the range asked for), never compressed (see provide).
-void send_bytes(const httplib::Request& req, httplib::Response& res, std::string bytes, const std::string& mime) {
-  send_ranged(req, res, std::move(bytes), mime, false);
+/// `bytes` as the answer, whole or the range asked for (answer_span). A range goes out uncompressed
+/// (Content-Range counts the bytes as they are); a whole answer as set_content() if `compress`,
+/// else provided.
+void send_ranged(const httplib::Request& req, httplib::Response& res, std::string bytes, const std::string& mime,
+                 bool compress) {
+  const auto span = answer_span(req, res, bytes.size());
+  if (!span) return;
+  if (res.status == 200 && compress) res.set_content(std::move(bytes), mime);
+  else if (res.status == 200) provide(res, std::move(bytes), mime);
+  else provide(res, bytes.substr(span->begin, span->length), mime);
+}
+
+/// An open file as the answer, whole or the range asked for (answer_span), read from the file as
+/// the client takes it (open_file.h), 64 KiB at a time, never compressed (see provide).
+void send_file(const httplib::Request& req, httplib::Response& res, std::shared_ptr<OpenFile> file,
+               const std::string& mime) {
+  const auto span = answer_span(req, res, file->size());
+  if (!span) return;
+  struct Reading {
+    std::shared_ptr<OpenFile> file;
+    Span span;
+    std::unique_ptr<char[]> buffer = std::make_unique<char[]>(kPiece);
+  };
+  auto reading = std::make_shared<Reading>(Reading{std::move(file), *span});
+  res.set_content_provider(span->length, mime,
+                           [reading](std::size_t offset, std::size_t length, httplib::DataSink& sink) {
+                             const Span& s = reading->span;
+                             if (offset >= s.length) return false;  // never past the bytes
+                             const std::size_t n = std::min({length, s.length - offset, kPiece});
+                             const long got = reading->file->read(s.begin + offset, reading->buffer.get(), n);
+                             if (got <= 0) return false;  // the file shrank: the connection ends short
+                             return sink.write(reading->buffer.get(), static_cast<std::size_t>(got));
+                           });
 }
 
 /// A JSON document (a job, a list, statistics) as a 200, or the range asked for.
@@ -1220,20 +1253,15 @@ void HttpServer::Impl::result(const httplib::Request& req, httplib::Response& re
     res.status = 304;
     return;
   }
-  // Read after the 304 (a revalidation reads no file); the file may go in between (then not a 500
-  // naming its path: the answer above).
-  std::string bytes;
-  try {
-    bytes = read_file(path);
-  } catch (const std::exception&) {
-  }
-  if (bytes.empty()) return unavailable();
+  // Opened after the 304 (a revalidation opens no file); the file may go in between (then not a 500
+  // naming its path: the answer above). Once open, it is served whole even if the job goes.
+  auto file = OpenFile::open(path);
+  if (!file || file->size() == 0) return unavailable();
   res.set_header("Content-Disposition",
                  remesh::api::content_disposition("attachment", rec->filename, "-" + mesh + "." + format));
   res.set_header("Accept-Ranges", "bytes");
   auto f = remesh::parse_format(format);
-  res.status = 200;
-  send_bytes(req, res, std::move(bytes), f ? std::string(remesh::mime_type(*f)) : "application/octet-stream");
+  send_file(req, res, std::move(file), f ? std::string(remesh::mime_type(*f)) : "application/octet-stream");
 }
 
 void HttpServer::Impl::stats(const httplib::Request& req, httplib::Response& res) {
@@ -1271,8 +1299,13 @@ void HttpServer::Impl::static_files(const httplib::Request& req, httplib::Respon
     send_problem(res, 404, "no such file: " + req.path.substr(0, 200));
     return;
   }
+  auto opened = OpenFile::open(*file);
+  if (!opened) {
+    send_problem(res, 404, "no such file: " + req.path.substr(0, 200));
+    return;
+  }
   res.set_header("Cache-Control", "no-cache");
-  send_bytes(req, res, read_file(*file), mime_for(*file));
+  send_file(req, res, std::move(opened), mime_for(*file));
 }
 
 HttpServer::HttpServer(const Options& options, JobManager& jobs, Metrics& metrics, Logger& log,

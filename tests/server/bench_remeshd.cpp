@@ -3,8 +3,14 @@
 //     0.5 ms) to each client receiving the event;
 //   - /healthz latency percentiles, polled every 20 ms meanwhile;
 //   - the daemon's resident memory (VmRSS, VmHWM) after those jobs and after each of 4 more run
-//     one after another (does it hold what the jobs freed?).
+//     one after another (does it hold what the jobs freed?), and with 40 downloads of a result open
+//     whose clients read nothing.
 // usage: bench_remeshd [clients=64] [subdiv=4] [iterations=40]
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
 #include <algorithm>
 #include <cstdlib>
 #include <fstream>
@@ -148,15 +154,47 @@ int main(int argc, char** argv) {
   for (const auto& id : ids) wait_final(c, id, 600);
   std::printf("  after the 2 jobs: %s\n", memory().c_str());
   std::printf("  4 more, one after another, after each:");
+  std::string last;
   for (int i = 0; i < 4; ++i) {
     auto r = submit_raw(c, sphere_obj(subdiv), query);
     if (!r || r->status != 202) {
       std::fprintf(stderr, "submit failed\n");
       return 1;
     }
-    wait_final(c, json::parse(r->body)["id"], 600);
+    last = json::parse(r->body)["id"];
+    wait_final(c, last, 600);
     std::printf("%s %s", i ? ";" : "", memory().c_str());
   }
   std::printf("\n");
+
+  // Downloads whose clients read nothing: each holds what the daemon keeps for it (QA: a copy of
+  // the whole file each, before downloads were read from the file as the client takes them).
+  const std::string path = "/api/v1/jobs/" + last + "/result?mesh=dual&format=lammps";
+  auto file = c.Get(path.c_str());
+  if (!file || file->status != 200) {
+    std::fprintf(stderr, "download failed\n");
+    return 1;
+  }
+  constexpr int kStalled = 40;
+  std::vector<int> sockets;
+  for (int i = 0; i < kStalled; ++i) {
+    const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
+    int small = 4096;
+    ::setsockopt(fd, SOL_SOCKET, SO_RCVBUF, &small, sizeof small);
+    sockaddr_in addr{};
+    addr.sin_family = AF_INET;
+    addr.sin_port = htons(static_cast<std::uint16_t>(d.port()));
+    addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    const std::string request = "GET " + path + " HTTP/1.1\r\nHost: x\r\n\r\n";
+    if (::connect(fd, reinterpret_cast<sockaddr*>(&addr), sizeof addr) == 0)
+      (void)::send(fd, request.data(), request.size(), MSG_NOSIGNAL);
+    sockets.push_back(fd);
+  }
+  std::this_thread::sleep_for(std::chrono::seconds(3));
+  std::printf("  %d downloads of a %.1f MB file, none read: %s\n", kStalled, static_cast<double>(file->body.size()) / 1e6,
+              memory().c_str());
+  for (int fd : sockets) ::close(fd);
+  std::this_thread::sleep_for(std::chrono::seconds(2));
+  std::printf("  after they closed: %s\n", memory().c_str());
   return 0;
 }

@@ -118,6 +118,14 @@ httplib::Result submit_raw(httplib::Client& c, const std::string& mesh, const st
   return c.Post(("/api/v1/jobs?" + query).c_str(), mesh, content_type.c_str());
 }
 
+std::string submit(httplib::Client& c, const std::string& mesh, const std::string& query) {
+  auto r = submit_raw(c, mesh, query);
+  if (!r) throw std::runtime_error("POST /api/v1/jobs?" + query + ": no answer");
+  if (r->status != 202)
+    throw std::runtime_error("POST /api/v1/jobs?" + query + ": " + std::to_string(r->status) + " " + r->body);
+  return nlohmann::json::parse(r->body)["id"];
+}
+
 nlohmann::json get_job(httplib::Client& c, const std::string& id) {
   auto r = c.Get(("/api/v1/jobs/" + id).c_str());
   if (!r || r->status != 200) throw std::runtime_error("GET job " + id + " failed");

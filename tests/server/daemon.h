@@ -53,6 +53,8 @@ std::string sphere_obj(int subdiv);
 /// POST the mesh raw with query parameters; returns the result (status, body).
 httplib::Result submit_raw(httplib::Client& c, const std::string& mesh, const std::string& query,
                            const std::string& content_type = "model/obj");
+/// POST the mesh raw with query parameters; the new job's id. Throws (with the answer) unless 202.
+std::string submit(httplib::Client& c, const std::string& mesh, const std::string& query);
 /// The job document or throws.
 nlohmann::json get_job(httplib::Client& c, const std::string& id);
 /// Polls until `pred(job)` holds; returns the job. Throws after `timeout` seconds.

@@ -17,14 +17,6 @@ using namespace remesh::test;
 
 namespace {
 
-std::string submit(httplib::Client& c, const std::string& mesh, const std::string& query) {
-  auto r = submit_raw(c, mesh, query);
-  REQUIRE(r);
-  INFO(r->body);
-  REQUIRE(r->status == 202);
-  return json::parse(r->body)["id"];
-}
-
 /// A job that runs long enough to be caught running (stopped by the tests).
 const char* kLong = "emin=0.02&emax=0.035&iterations=400&run_all_iterations=true";
 /// A job of a few quick iterations.

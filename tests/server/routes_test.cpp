@@ -1,6 +1,11 @@
 // Every route and every error status of the public API, against the real daemon.
 #include <catch2/catch.hpp>
 
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -1334,10 +1339,7 @@ TEST_CASE("remeshd: pipelined requests are answered in order and a body is never
   TempDir tmp;
   Daemon d(tmp.path / "data", {"--workers", "1"});
   auto c = d.client();
-  auto victim = submit_raw(c, sphere_obj(1), "emin=0.3&emax=0.5&iterations=2");
-  REQUIRE(victim);
-  REQUIRE(victim->status == 202);
-  const std::string id = body_of(victim)["id"];
+  const std::string id = submit(c, sphere_obj(1), "emin=0.3&emax=0.5&iterations=2");
   auto statuses = [](const std::string& answer) {
     std::vector<std::string> out;
     const std::regex status_line(R"(HTTP/1\.1 (\d{3}) )");
@@ -1402,4 +1404,51 @@ TEST_CASE("remeshd: a gzip or deflate upload cut off is refused and not taken fo
                                         "' (or it was cut off)");
   }
   CHECK(json::parse(c.Get("/api/v1/jobs")->body)["total"] == 2);  // the two whole ones
+}
+
+TEST_CASE("remeshd: a download under way finishes whole when its job is removed meanwhile", "[server]") {
+  // Downloads are read from the file as the client takes them (open_file.h); the job's removal
+  // unlinks the file, which the download holds open.
+  TempDir tmp;
+  Daemon d(tmp.path / "data", {"--workers", "1"});
+  auto c = d.client();
+  const std::string id = submit(c, sphere_obj(4), "emin=0.02&emax=0.03");
+  REQUIRE(wait_final(c, id, 120)["state"] == "succeeded");
+  const std::string path = "/api/v1/jobs/" + id + "/result?mesh=dual&format=lammps";
+  auto whole = c.Get(path.c_str());
+  REQUIRE(whole);
+  REQUIRE(whole->status == 200);
+  REQUIRE(whole->body.size() > 2'000'000);
+
+  // A client that reads the head and a little, then waits while the job is removed.
+  const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
+  REQUIRE(fd >= 0);
+  int small = 4096;
+  ::setsockopt(fd, SOL_SOCKET, SO_RCVBUF, &small, sizeof small);
+  timeval tv{10, 0};
+  ::setsockopt(fd, SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof tv);
+  sockaddr_in addr{};
+  addr.sin_family = AF_INET;
+  addr.sin_port = htons(static_cast<std::uint16_t>(d.port()));
+  addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  REQUIRE(::connect(fd, reinterpret_cast<sockaddr*>(&addr), sizeof addr) == 0);
+  const std::string request = "GET " + path + " HTTP/1.1\r\nHost: x\r\nConnection: close\r\n\r\n";
+  REQUIRE(::send(fd, request.data(), request.size(), MSG_NOSIGNAL) == static_cast<ssize_t>(request.size()));
+  std::string answer;
+  char buffer[4096];
+  while (answer.size() < 8192) {
+    const ssize_t n = ::recv(fd, buffer, sizeof buffer, 0);
+    REQUIRE(n > 0);
+    answer.append(buffer, static_cast<std::size_t>(n));
+  }
+  auto removed = c.Delete(("/api/v1/jobs/" + id).c_str());
+  REQUIRE(removed);
+  CHECK(removed->status == 204);
+  CHECK(c.Get(path.c_str())->status == 404);
+  for (ssize_t n; (n = ::recv(fd, buffer, sizeof buffer, 0)) > 0;) answer.append(buffer, static_cast<std::size_t>(n));
+  ::close(fd);
+  const std::size_t head_end = answer.find("\r\n\r\n");
+  REQUIRE(head_end != std::string::npos);
+  CHECK(answer.rfind("HTTP/1.1 200", 0) == 0);
+  CHECK(answer.substr(head_end + 4) == whole->body);
 }

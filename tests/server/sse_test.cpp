@@ -12,14 +12,6 @@ using namespace remesh::test;
 
 namespace {
 
-std::string submit(httplib::Client& c, const std::string& mesh, const std::string& query) {
-  auto r = submit_raw(c, mesh, query);
-  REQUIRE(r);
-  INFO(r->body);
-  REQUIRE(r->status == 202);
-  return json::parse(r->body)["id"];
-}
-
 std::vector<SseEvent> of_kind(const SseStream& s, const std::string& kind) {
   std::vector<SseEvent> out;
   for (const auto& e : s.events)

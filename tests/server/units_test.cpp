@@ -1,6 +1,8 @@
 // Pieces of remeshd that need no process: options, static paths, SSE frames, storage.
 #include <catch2/catch.hpp>
 
+#include <unistd.h>
+
 #include <chrono>
 #include <cstdlib>
 #include <atomic>
@@ -17,6 +19,7 @@
 #include "io/mesh_io.h"
 #include "job_runner.h"
 #include "job_store.h"
+#include "open_file.h"
 #include "options.h"
 #include "routes.h"
 #include "sse.h"
@@ -335,4 +338,29 @@ TEST_CASE("UploadGate: slots, a bounded wait, a bounded line, and close", "[serv
   CHECK(two.busy() == 1);
   moved.reset();
   CHECK(two.busy() == 0);
+}
+
+TEST_CASE("OpenFile: reads a file by offset, keeps it when it is removed, refuses what is no file", "[server][storage]") {
+  const fs::path dir = fs::temp_directory_path() / ("remeshd_open_file_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  const fs::path path = dir / "result.obj";
+  std::string text;
+  for (int i = 0; i < 20000; ++i) text += "v " + std::to_string(i) + " 0 0\n";
+  std::ofstream(path, std::ios::binary) << text;
+  auto file = OpenFile::open(path);
+  REQUIRE(file);
+  CHECK(file->size() == text.size());
+  fs::remove(path);  // as a job's removal does
+  std::string back(text.size(), '\0');
+  for (std::size_t at = 0; at < text.size();) {  // in pieces, as a download reads it
+    const long got = file->read(at, back.data() + at, std::min<std::size_t>(70000, text.size() - at));
+    REQUIRE(got > 0);
+    at += static_cast<std::size_t>(got);
+  }
+  CHECK(back == text);
+  char byte;
+  CHECK(file->read(text.size(), &byte, 1) == 0);
+  CHECK_FALSE(OpenFile::open(path));  // gone
+  CHECK_FALSE(OpenFile::open(dir));   // a directory
+  fs::remove_all(dir);
 }
