@@ -306,6 +306,20 @@ json parse_noting_repeats(const std::string& text, std::vector<std::string>& rep
   return parsed;
 }
 
+/// Why `text` is not JSON, as nlohmann's parser says it ("parse error at line 1, column 9: ...",
+/// "number overflow parsing '1e400'"), without its exception's tag, at most 200 bytes.
+std::string json_error(const std::string& text) {
+  try {
+    [[maybe_unused]] const json parsed = json::parse(text);
+  } catch (const json::exception& e) {
+    std::string message = e.what();
+    if (const std::size_t tag = message.find("] "); message.starts_with("[json.exception") && tag != std::string::npos)
+      message.erase(0, tag + 2);
+    return message.substr(0, 200);
+  }
+  return "";
+}
+
 /// The query of a request target ("/path?a=1&b=x%3Dy"), each pair split at its first '=' and
 /// percent-decoded ('+' as a space), in order, repeats kept. cpp-httplib 0.11 splits a pair at every
 /// '=' and keeps the last piece as the value: "emin=0.1=0.12" was emin 0.12, a base64 token's
@@ -951,7 +965,7 @@ void HttpServer::Impl::post_job(const httplib::Request& req, httplib::Response& 
     std::vector<std::string> repeated;
     const json j = parse_noting_repeats(params_text, repeated);
     if (params_too_big) errors.push_back({"params", "is larger than 64 KiB"});
-    else if (j.is_discarded()) errors.push_back({"params", "is not valid JSON"});
+    else if (j.is_discarded()) errors.push_back({"params", "is not valid JSON: " + json_error(params_text)});
     else if (!j.is_object()) errors.push_back({"params", "must be a JSON object of the job's parameters"});
     else parsed = remesh::params_from_json(j);
     for (const std::string& key : repeated)

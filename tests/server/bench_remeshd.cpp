@@ -168,7 +168,11 @@ int main(int argc, char** argv) {
   std::printf("\n");
 
   // Downloads whose clients read nothing: each holds what the daemon keeps for it (QA: a copy of
-  // the whole file each, before downloads were read from the file as the client takes them).
+  // the whole file each, before downloads were read from the file as the client takes them). The
+  // file is larger than the socket buffers take in (loopback's grow to 4 MB): a job of its own.
+  last = submit(c, sphere_obj(5), "emin=0.012&emax=0.018&iterations=10");
+  wait_final(c, last, 600);
+  std::printf("  after a larger job (icosphere subdiv 5 at [0.012, 0.018]): %s\n", memory().c_str());
   const std::string path = "/api/v1/jobs/" + last + "/result?mesh=dual&format=lammps";
   auto file = c.Get(path.c_str());
   if (!file || file->status != 200) {

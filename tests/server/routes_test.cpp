@@ -523,6 +523,13 @@ TEST_CASE("remeshd: the errors each route must give", "[server]") {
   REQUIRE(bj);
   CHECK(bj->status == 422);
   CHECK(error_fields(bj) == std::set<std::string>{"params"});
+  // Why, as the parser says it: a number past the doubles was "is not valid JSON" alone (QA).
+  CHECK(body_of(bj)["errors"][0]["message"].get<std::string>().starts_with("is not valid JSON: parse error at line 1, column 2"));
+  httplib::MultipartFormDataItems overflow = {{"mesh", mesh, "a.obj", ""}, {"params", R"({"emin":1e400})", "", ""}};
+  auto ov = c.Post("/api/v1/jobs", overflow);
+  REQUIRE(ov);
+  CHECK(ov->status == 422);
+  CHECK(body_of(ov)["errors"][0]["message"] == "is not valid JSON: number overflow parsing '1e400'");
   // Two mesh parts (and two params parts) are refused, not joined into one mesh.
   httplib::MultipartFormDataItems two_meshes = {
       {"mesh", mesh, "a.obj", ""}, {"mesh", mesh, "b.obj", ""}, {"params", R"({"emin":1,"emax":2})", "", ""}};
