@@ -785,6 +785,28 @@ httplib::Server::HandlerResponse HttpServer::Impl::pre_route(const httplib::Requ
 /// gives the length ("bytes */N") from the handlers that honour ranges, the whole answer from the
 /// others (the event stream). GET, HEAD and DELETE only: a POST, PUT or PATCH keeps its 416 (its
 /// body, unread, closes the connection).
+/// One byte range "first-last", "first-" or "-suffix" (RFC 9110 14.1.2) whose numbers run past 64
+/// bits, which httplib's parser refuses: a number past 2^62 is taken as 2^62, longer than any
+/// answer, so the range is clamped to the answer's end as any other (QA: "bytes=0-99999999999999999999"
+/// was a 416, and so was "bytes=-99999999999999999999", the whole answer). nullopt for anything else.
+std::optional<httplib::Range> long_byte_range(std::string_view spec) {
+  constexpr long long kHuge = 1LL << 62;
+  const std::size_t dash = spec.find('-');
+  if (dash == std::string_view::npos) return std::nullopt;
+  const std::string_view first = spec.substr(0, dash), last = spec.substr(dash + 1);
+  auto digits = [](std::string_view d) { return !d.empty() && d.find_first_not_of("0123456789") == std::string_view::npos; };
+  auto number = [&](std::string_view d) {
+    long long v = 0;
+    for (char ch : d) v = v > kHuge / 10 ? kHuge : std::min(kHuge, v * 10 + (ch - '0'));
+    return v;
+  };
+  if (first.empty()) return digits(last) ? std::optional(httplib::Range{-1, number(last)}) : std::nullopt;
+  if (!digits(first) || !(last.empty() || digits(last))) return std::nullopt;
+  const long long a = number(first), b = last.empty() ? -1 : number(last);
+  if (b >= 0 && b < a) return std::nullopt;
+  return httplib::Range{a, b};
+}
+
 httplib::Server::HandlerResponse HttpServer::Impl::unparsed_range(const httplib::Request& req,
                                                                   httplib::Response& res) {
   auto& request = const_cast<httplib::Request&>(req);
@@ -803,7 +825,8 @@ httplib::Server::HandlerResponse HttpServer::Impl::unparsed_range(const httplib:
                        return std::tolower(static_cast<unsigned char>(a)) == b;
                      });
   httplib::Ranges parsed;
-  if (get && bytes && !httplib::detail::parse_range_header("bytes=" + range.substr(6), parsed)) t_range = kMalformed;
+  if (get && bytes && !httplib::detail::parse_range_header("bytes=" + range.substr(6), parsed))
+    t_range = long_byte_range(std::string_view(range).substr(6)).value_or(kMalformed);
   else if (get && parsed.size() == 1) t_range = parsed.front();
   // A DELETE routed from here has its body (if any) unread: the connection ends after the answer.
   if (!get && has_body(req)) res.set_header("Connection", "close");
