@@ -22,8 +22,12 @@ struct BodyDecoder::Impl {
     z.avail_in = static_cast<uInt>(n);
     while (z.avail_in > 0) {
       if (ended) {
-        // Bytes after the end: another gzip member (RFC 1952 2.2), else not the coding.
-        if (kind != Kind::Gzip || inflateReset(&z) != Z_OK) return false;
+        // Bytes after the end: another gzip member (RFC 1952 2.2), or zeros padding it (as GNU gzip
+        // takes them: tape blocks); else not the coding.
+        if (kind != Kind::Gzip) return false;
+        while (z.avail_in > 0 && *z.next_in == 0) ++z.next_in, --z.avail_in;
+        if (z.avail_in == 0) break;
+        if (inflateReset(&z) != Z_OK) return false;
         ended = false;
       }
       z.next_out = out.data();

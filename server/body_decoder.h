@@ -19,7 +19,7 @@ class BodyDecoder {
   /// Receives decoded bytes; returns false to stop decoding.
   using Sink = std::function<bool(const char*, std::size_t)>;
 
-  /// `coding`: "gzip" (one or more members) or "deflate" (zlib's format; either header is
+  /// `coding`: "gzip" (one or more members, zero bytes after them ignored) or "deflate" (zlib's format; either header is
   /// recognised, as by httplib), or "br". Throws std::invalid_argument for any other.
   explicit BodyDecoder(std::string_view coding);
   ~BodyDecoder();

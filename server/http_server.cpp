@@ -488,8 +488,14 @@ void HttpServer::Impl::setup() {
   for (const RouteSpec& r : kRoutes)
     route_labels.emplace_back(std::regex(route_pattern(r.path)), r.path);
 
-  server.set_pre_routing_handler(
-      [this](const httplib::Request& req, httplib::Response& res) { return pre_route(req, res); });
+  server.set_pre_routing_handler([this](const httplib::Request& req, httplib::Response& res) {
+    const auto answer = pre_route(req, res);
+    // Answered before its body is read: the connection ends with the answer, or the body would be
+    // read as the next request (connection_server.h keeps what was read past the head; review: a
+    // 401 to a POST whose body was a request ran that request).
+    if (answer == httplib::Server::HandlerResponse::Handled && has_body(req)) res.set_header("Connection", "close");
+    return answer;
+  });
   server.set_post_routing_handler([this](const httplib::Request& req, httplib::Response& res) {
     cors_headers(res);
     res.set_header("X-Content-Type-Options", "nosniff");
@@ -952,8 +958,13 @@ void HttpServer::Impl::post_job(const httplib::Request& req, httplib::Response& 
       ok = reader(keep);
     } else {
       BodyDecoder decoder(t_body_coding);
-      ok = reader([&](const char* data, std::size_t n) { return decoder.feed(data, n, keep); });
-      if (ok && !too_big && !decoder.complete()) ok = false;  // cut off
+      std::size_t coded = 0;
+      ok = reader([&](const char* data, std::size_t n) {
+        coded += n;
+        return decoder.feed(data, n, keep);
+      });
+      // Cut off; an empty body is left to the checks below ("mesh is empty"), as without a coding.
+      if (ok && !too_big && coded > 0 && !decoder.complete()) ok = false;
     }
     filename = req.get_param_value("filename");
     part_type = req.get_header_value("Content-Type");
@@ -964,6 +975,8 @@ void HttpServer::Impl::post_job(const httplib::Request& req, httplib::Response& 
     return;
   }
   if (!ok) {
+    // The rest of the body is unread (or its framing broken): it must not be read as a request.
+    res.set_header("Connection", "close");
     std::string type = req.get_header_value("Content-Type");
     auto b = type.find("boundary=");
     if (req.is_multipart_form_data() && b != std::string::npos && type.find(';', b) != std::string::npos)

@@ -144,6 +144,13 @@ TEST_CASE("BodyDecoder: gzip members one after another, a sink that stops, unkno
   CHECK(two.fed);
   CHECK(two.complete);
   CHECK(two.text == a + b);
+  // Zeros after a member pad it (GNU gzip takes them); anything else after the end is refused.
+  const Decoded padded = decode("gzip", zlib_code(a, 31) + std::string(512, '\0'), 64, 6);
+  CHECK(padded.fed);
+  CHECK(padded.complete);
+  CHECK(padded.text == a);
+  const Decoded garbage = decode("gzip", zlib_code(a, 31) + std::string(8, '\0') + "xyz", 64, 7);
+  CHECK_FALSE((garbage.fed && garbage.complete));
   // One zlib stream after another is not deflate.
   CHECK_FALSE(decode("deflate", zlib_code(a, 15) + zlib_code(b, 15), 5, 5).fed);
 
