@@ -65,6 +65,12 @@ void provide(httplib::Response& res, std::string bytes, const std::string& mime)
 
 constexpr const char* kPrefix = "/api/v1";
 constexpr std::size_t kMiB = 1024 * 1024;
+/// How many uploads' worth (--max-upload-mb each) of bytes decoded from coded bodies the requests
+/// hold at once. A coded body costs its client far less than it decodes to (a gzip body of zeros:
+/// 1.5 MB decodes to the 256 MiB limit), and each request holds its bytes until its mesh is read:
+/// 80 such requests at once (the HTTP threads) held 20 GB. Past the budget, a coded upload gets a 503
+/// (review). Plain bodies cost their clients what they hold.
+constexpr std::size_t kCodedUploadsAtOnce = 4;
 /// What a download reads from its file at a time.
 constexpr std::size_t kPiece = 64 * 1024;
 /// Uploads from this size on have the memory they took handed back to the system after their answer.
@@ -360,6 +366,9 @@ struct HttpServer::Impl {
   std::filesystem::path web_root;
   ConnectionServer server;
   std::atomic<std::size_t> streams{0};
+  /// Bytes decoded from coded uploads (Content-Encoding) that requests hold, all together: at most
+  /// kCodedUploadsAtOnce uploads' worth (post_job).
+  std::atomic<std::size_t> decoded_held{0};
   std::vector<std::pair<std::regex, std::string>> route_labels;
   std::chrono::steady_clock::time_point started = std::chrono::steady_clock::now();
   std::mutex served_mutex;
@@ -890,7 +899,7 @@ void HttpServer::Impl::post_job(const httplib::Request& req, httplib::Response& 
     }
   } trim_after{jobs, total};
   std::string body, params_text, filename, part_type, part;
-  bool too_big = false, params_too_big = false;
+  bool too_big = false, params_too_big = false, over_budget = false;
   int mesh_parts = 0, params_parts = 0;  // a second part of either is refused, not joined to the first
   std::vector<std::string> other_parts;  // parts of other names, each once (refused, named)
   constexpr std::size_t kMaxNamedParts = 16;
@@ -959,15 +968,44 @@ void HttpServer::Impl::post_job(const httplib::Request& req, httplib::Response& 
     } else {
       BodyDecoder decoder(t_body_coding);
       std::size_t coded = 0;
+      // The decoded bytes this request holds, counted in decoded_held until it ends.
+      struct Held {
+        std::atomic<std::size_t>& all;
+        std::size_t mine = 0;
+        ~Held() { all -= mine; }
+      } held{decoded_held};
+      const std::size_t budget = kCodedUploadsAtOnce * limit;
+      auto hold = [&](const char* data, std::size_t n) {
+        if (!too_big) {
+          if (decoded_held.fetch_add(n) + n > budget) {
+            decoded_held -= n;
+            over_budget = true;
+            return false;
+          }
+          held.mine += n;
+        }
+        const bool more = keep(data, n);
+        if (too_big) decoded_held -= std::exchange(held.mine, 0);  // the body is let go (count)
+        return more;
+      };
       ok = reader([&](const char* data, std::size_t n) {
         coded += n;
-        return decoder.feed(data, n, keep);
+        return decoder.feed(data, n, hold);
       });
       // Cut off; an empty body is left to the checks below ("mesh is empty"), as without a coding.
       if (ok && !too_big && coded > 0 && !decoder.complete()) ok = false;
     }
     filename = req.get_param_value("filename");
     part_type = req.get_header_value("Content-Type");
+  }
+  if (over_budget) {
+    metrics.count_busy(Metrics::Busy::UploadSlots);
+    res.set_header("Retry-After", "10");
+    res.set_header("Connection", "close");  // the rest of the body is unread
+    send_problem(res, 503, "the server is decoding other compressed uploads (" +
+                               std::to_string(kCodedUploadsAtOnce * options.max_upload_mb) +
+                               " MiB of them at once at most): try again in a few seconds, or send it uncompressed");
+    return;
   }
   if (too_big || res.status == 413) {
     send_problem(res, 413, "the upload is larger than the limit of " + std::to_string(options.max_upload_mb) + " MiB");

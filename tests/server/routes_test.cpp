@@ -51,6 +51,26 @@ std::vector<std::string> status_codes(const std::string& answer) {
   return out;
 }
 
+/// `text` coded by zlib (window bits `wbits`: 31 gzip, 15 deflate) in two parts, a sync flush after
+/// its first `part` bytes, which end at coded byte `flushed`: the coded bytes before it decode to
+/// that part without an error.
+std::string coded_in_two(const std::string& text, std::size_t part, int wbits, std::size_t& flushed) {
+  z_stream z{};
+  REQUIRE(deflateInit2(&z, 6, Z_DEFLATED, wbits, 8, Z_DEFAULT_STRATEGY) == Z_OK);
+  std::string coded(text.size() + 1024, '\0');
+  z.next_out = reinterpret_cast<Bytef*>(coded.data());
+  z.avail_out = static_cast<uInt>(coded.size());
+  z.next_in = reinterpret_cast<Bytef*>(const_cast<char*>(text.data()));
+  z.avail_in = static_cast<uInt>(part);
+  REQUIRE(deflate(&z, Z_SYNC_FLUSH) == Z_OK);
+  flushed = coded.size() - z.avail_out;
+  z.avail_in = static_cast<uInt>(text.size() - part);
+  REQUIRE(deflate(&z, Z_FINISH) == Z_STREAM_END);
+  coded.resize(coded.size() - z.avail_out);
+  deflateEnd(&z);
+  return coded;
+}
+
 /// The text of api/openapi.yaml in the source tree.
 std::string openapi_yaml() {
   std::ifstream in(REMESHD_OPENAPI);
@@ -1398,19 +1418,8 @@ TEST_CASE("remeshd: a gzip or deflate upload cut off is refused and not taken fo
     // the first part alone decodes without error into a mesh with fewer faces and a hole.
     const std::size_t part = mesh.rfind('\n', mesh.size() * 3 / 4) + 1;
     REQUIRE(mesh.compare(part, 2, "f ") == 0);
-    z_stream z{};
-    REQUIRE(deflateInit2(&z, 6, Z_DEFLATED, wbits, 8, Z_DEFAULT_STRATEGY) == Z_OK);
-    std::string coded(mesh.size() + 1024, '\0');
-    z.next_out = reinterpret_cast<Bytef*>(coded.data());
-    z.avail_out = static_cast<uInt>(coded.size());
-    z.next_in = reinterpret_cast<Bytef*>(const_cast<char*>(mesh.data()));
-    z.avail_in = static_cast<uInt>(part);
-    REQUIRE(deflate(&z, Z_SYNC_FLUSH) == Z_OK);
-    const std::size_t flushed = coded.size() - z.avail_out;
-    z.avail_in = static_cast<uInt>(mesh.size() - part);
-    REQUIRE(deflate(&z, Z_FINISH) == Z_STREAM_END);
-    coded.resize(coded.size() - z.avail_out);
-    deflateEnd(&z);
+    std::size_t flushed = 0;
+    const std::string coded = coded_in_two(mesh, part, wbits, flushed);
 
     auto whole = c.Post("/api/v1/jobs?emin=0.3&emax=0.5&filename=s.obj", {{"Content-Encoding", coding}}, coded,
                         "model/obj");
@@ -1508,4 +1517,43 @@ TEST_CASE("remeshd: a body refused before it is read whole ends the connection",
   auto still = c.Get(("/api/v1/jobs/" + id).c_str());
   REQUIRE(still);
   CHECK(still->status == 200);
+}
+
+TEST_CASE("remeshd: compressed uploads decode a bounded amount at once, the rest get a 503", "[server][uploads]") {
+  // A coded body costs its client far less than it decodes to, and each request holds its decoded
+  // bytes until its mesh is read: at most 4 uploads' worth at once (review: 80 bodies of 1.5 MB of
+  // gzip held 20 GB). With --max-upload-mb 1: 4 MiB.
+  TempDir tmp;
+  Daemon d(tmp.path / "data", {"--workers", "1", "--max-upload-mb", "1"});
+  std::string text;
+  while (text.size() < 900 * 1024) text += "v 0 0 0\n";
+  std::size_t flushed = 0;
+  const std::string coded = coded_in_two(text, text.size() - 8, 31, flushed);
+  const std::string head = "POST /api/v1/jobs?emin=0.3&emax=0.5&filename=a.obj HTTP/1.1\r\nHost: x\r\n"
+                           "Content-Encoding: gzip\r\nConnection: close\r\nContent-Length: " +
+                           std::to_string(coded.size()) + "\r\n\r\n";
+  // Four uploads hold 0.9 MiB each for 3 s (the rest of each body comes later).
+  std::vector<std::string> answers(4);
+  std::vector<std::thread> holders;
+  for (int i = 0; i < 4; ++i)
+    holders.emplace_back([&, i] {
+      answers[static_cast<std::size_t>(i)] =
+          raw_exchange(d.port(), {head + coded.substr(0, flushed), coded.substr(flushed)}, 3.0, 20);
+    });
+  std::this_thread::sleep_for(std::chrono::milliseconds(1500));
+  auto c = d.client();
+  auto fifth = c.Post("/api/v1/jobs?emin=0.3&emax=0.5&filename=a.obj", {{"Content-Encoding", "gzip"}}, coded, "model/obj");
+  for (auto& t : holders) t.join();
+  REQUIRE(fifth);
+  CHECK(fifth->status == 503);
+  CHECK(fifth->get_header_value("Retry-After") == "10");
+  CHECK(body_of(fifth)["detail"].get<std::string>().find("decoding other compressed uploads (4 MiB") != std::string::npos);
+  for (const std::string& answer : answers) CHECK(status_codes(answer) == std::vector<std::string>{"422"});  // no faces
+  // Their bytes let go, the next one is read.
+  auto after = c.Post("/api/v1/jobs?emin=0.3&emax=0.5&filename=a.obj", {{"Content-Encoding", "gzip"}}, coded, "model/obj");
+  REQUIRE(after);
+  CHECK(after->status == 422);
+  auto metrics = c.Get("/metrics");
+  REQUIRE(metrics);
+  CHECK(metrics->body.find("remeshd_busy_refusals_total{reason=\"upload_slots\"} 1") != std::string::npos);
 }
