@@ -903,11 +903,27 @@ void HttpServer::Impl::post_job(const httplib::Request& req, httplib::Response& 
   int mesh_parts = 0, params_parts = 0;  // a second part of either is refused, not joined to the first
   std::vector<std::string> other_parts;  // parts of other names, each once (refused, named)
   constexpr std::size_t kMaxNamedParts = 16;
+  // A coded body's decoded bytes count in decoded_held while the request holds them (kCodedUploadsAtOnce).
+  const bool coded_body = !t_body_coding.empty() || req.has_header("Content-Encoding");
+  struct Held {
+    std::atomic<std::size_t>& all;
+    std::size_t mine = 0;
+    ~Held() { all -= mine; }
+  } held{decoded_held};
   auto count = [&](std::size_t n) {
+    if (coded_body && !too_big) {
+      if (decoded_held.fetch_add(n) + n > kCodedUploadsAtOnce * limit) {
+        decoded_held -= n;
+        over_budget = true;
+        return false;
+      }
+      held.mine += n;
+    }
     total += n;
     if (total > limit && !too_big) {
       too_big = true;
       std::string().swap(body);  // nothing of an over-limit upload is kept
+      decoded_held -= std::exchange(held.mine, 0);
     }
     return total <= limit + kDrainBytes;  // past this, stop reading and close
   };
@@ -968,29 +984,9 @@ void HttpServer::Impl::post_job(const httplib::Request& req, httplib::Response& 
     } else {
       BodyDecoder decoder(t_body_coding);
       std::size_t coded = 0;
-      // The decoded bytes this request holds, counted in decoded_held until it ends.
-      struct Held {
-        std::atomic<std::size_t>& all;
-        std::size_t mine = 0;
-        ~Held() { all -= mine; }
-      } held{decoded_held};
-      const std::size_t budget = kCodedUploadsAtOnce * limit;
-      auto hold = [&](const char* data, std::size_t n) {
-        if (!too_big) {
-          if (decoded_held.fetch_add(n) + n > budget) {
-            decoded_held -= n;
-            over_budget = true;
-            return false;
-          }
-          held.mine += n;
-        }
-        const bool more = keep(data, n);
-        if (too_big) decoded_held -= std::exchange(held.mine, 0);  // the body is let go (count)
-        return more;
-      };
       ok = reader([&](const char* data, std::size_t n) {
         coded += n;
-        return decoder.feed(data, n, hold);
+        return decoder.feed(data, n, keep);
       });
       // Cut off; an empty body is left to the checks below ("mesh is empty"), as without a coding.
       if (ok && !too_big && coded > 0 && !decoder.complete()) ok = false;

@@ -1543,7 +1543,15 @@ TEST_CASE("remeshd: compressed uploads decode a bounded amount at once, the rest
   std::this_thread::sleep_for(std::chrono::milliseconds(1500));
   auto c = d.client();
   auto fifth = c.Post("/api/v1/jobs?emin=0.3&emax=0.5&filename=a.obj", {{"Content-Encoding", "gzip"}}, coded, "model/obj");
+  // A multipart body coded as a whole, which httplib decodes before its parts, alike.
+  const std::string form = "--XX\r\nContent-Disposition: form-data; name=\"mesh\"; filename=\"a.obj\"\r\n\r\n" + text +
+                           "\r\n--XX--\r\n";
+  std::size_t unused = 0;
+  auto sixth = c.Post("/api/v1/jobs?emin=0.3&emax=0.5", {{"Content-Encoding", "gzip"}},
+                      coded_in_two(form, form.size() / 2, 31, unused), "multipart/form-data; boundary=XX");
   for (auto& t : holders) t.join();
+  REQUIRE(sixth);
+  CHECK(sixth->status == 503);
   REQUIRE(fifth);
   CHECK(fifth->status == 503);
   CHECK(fifth->get_header_value("Retry-After") == "10");
@@ -1555,5 +1563,5 @@ TEST_CASE("remeshd: compressed uploads decode a bounded amount at once, the rest
   CHECK(after->status == 422);
   auto metrics = c.Get("/metrics");
   REQUIRE(metrics);
-  CHECK(metrics->body.find("remeshd_busy_refusals_total{reason=\"upload_slots\"} 1") != std::string::npos);
+  CHECK(metrics->body.find("remeshd_busy_refusals_total{reason=\"upload_slots\"} 2") != std::string::npos);
 }
