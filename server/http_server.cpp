@@ -792,14 +792,8 @@ httplib::Server::HandlerResponse HttpServer::Impl::pre_route(const httplib::Requ
   return httplib::Server::HandlerResponse::Unhandled;
 }
 
-/// A Range header cpp-httplib 0.11 cannot parse ("items=0-5", "bytes=zz", "bytes=5-1", "Bytes=0-5")
-/// it answers with a bare 416 before routing (Server::process_request): neither the pre-routing
-/// handler nor a route sees the request, the error handler is the first to. Routed here as httplib
-/// would have: a unit other than bytes is ignored (RFC 9110 14.2: the whole answer), the unit's case
-/// does not matter ("Bytes=0-5" is bytes 0-5), and a malformed bytes range is kMalformed: a 416 that
-/// gives the length ("bytes */N") from the handlers that honour ranges, the whole answer from the
-/// others (the event stream). GET, HEAD and DELETE only: a POST, PUT or PATCH keeps its 416 (its
-/// body, unread, closes the connection).
+namespace {
+
 /// One byte range "first-last", "first-" or "-suffix" (RFC 9110 14.1.2) whose numbers run past 64
 /// bits, which httplib's parser refuses: a number past 2^62 is taken as 2^62, longer than any
 /// answer, so the range is clamped to the answer's end as any other (QA: "bytes=0-99999999999999999999"
@@ -822,6 +816,16 @@ std::optional<httplib::Range> long_byte_range(std::string_view spec) {
   return httplib::Range{a, b};
 }
 
+}  // namespace
+
+/// A Range header cpp-httplib 0.11 cannot parse ("items=0-5", "bytes=zz", "bytes=5-1", "Bytes=0-5")
+/// it answers with a bare 416 before routing (Server::process_request): neither the pre-routing
+/// handler nor a route sees the request, the error handler is the first to. Routed here as httplib
+/// would have: a unit other than bytes is ignored (RFC 9110 14.2: the whole answer), the unit's case
+/// does not matter ("Bytes=0-5" is bytes 0-5), and a malformed bytes range is kMalformed: a 416 that
+/// gives the length ("bytes */N") from the handlers that honour ranges, the whole answer from the
+/// others (the event stream). GET, HEAD and DELETE only: a POST, PUT or PATCH keeps its 416 (its
+/// body, unread, closes the connection).
 httplib::Server::HandlerResponse HttpServer::Impl::unparsed_range(const httplib::Request& req,
                                                                   httplib::Response& res) {
   auto& request = const_cast<httplib::Request&>(req);
