@@ -60,13 +60,28 @@ void address_of(socket_t sock, bool peer, std::string& ip, int& port) {
 /// One connection's stream, for all of its requests: what a read took from the socket past the
 /// bytes asked for stays for the next read, the next request's included. httplib reads a request
 /// head a byte at a time, so the stream reads ahead by up to a buffer. Reads and writes wait up to
-/// the server's read and write timeouts; a write fails once the peer has closed (as 0.11.4's).
+/// the server's read and write timeouts; a write fails once the peer has closed while it is
+/// answered (as 0.11.4's, which also failed when the peer had closed only its sending side).
 class ConnectionStream final : public httplib::Stream {
  public:
   ConnectionStream(socket_t sock, long read_ms, long write_ms) : sock_(sock), read_ms_(read_ms), write_ms_(write_ms) {}
 
   bool is_readable() const override { return buffered() || wait_for(sock_, POLLIN, read_ms_) > 0; }
-  bool is_writable() const override { return wait_for(sock_, POLLOUT, write_ms_) > 0 && peer_open(sock_); }
+  bool is_writable() const override {
+    if (wait_for(sock_, POLLOUT, write_ms_) <= 0) return false;
+    if (peer_open(sock_)) {
+      answering_ = true;
+      return true;
+    }
+    // The peer sent end of file. Before any of the answer went out, that is a client that closed
+    // its sending side after its request (nc -N, shutdown(SHUT_WR)) and still reads: it is answered
+    // (0.11.4 wrote it nothing; a peer that closed entirely resets the connection, and a write then
+    // fails). Once answering, it is a client gone: an event stream stops there.
+    if (!answering_) half_closed_ = true;
+    return half_closed_;
+  }
+  /// A request begins: its answer has not started.
+  void next_answer() { answering_ = false; }
 
   ssize_t read(char* ptr, size_t size) override {
     if (buffered()) return take(ptr, size);
@@ -112,6 +127,8 @@ class ConnectionStream final : public httplib::Stream {
   long read_ms_, write_ms_;
   std::array<char, 4096> buffer_{};
   std::size_t begin_ = 0, end_ = 0;
+  mutable bool answering_ = false;    ///< some of the current answer is written
+  mutable bool half_closed_ = false;  ///< the client closed its side before an answer began
 };
 
 /// Whether the next request has begun: bytes already read, or bytes arriving within
@@ -144,6 +161,7 @@ bool ConnectionServer::process_and_close_socket(socket_t sock) {
   for (std::size_t left = keep_alive_max_count_; left > 0 && next_request(strm, sock, svr_sock_, keep_alive_timeout_sec_);
        --left) {
     bool closed = false;
+    strm.next_answer();
     ok = process_request(strm, left == 1, closed, nullptr);
     if (!ok || closed) break;
   }

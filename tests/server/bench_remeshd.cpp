@@ -182,16 +182,10 @@ int main(int argc, char** argv) {
   constexpr int kStalled = 40;
   std::vector<int> sockets;
   for (int i = 0; i < kStalled; ++i) {
-    const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
-    int small = 4096;
-    ::setsockopt(fd, SOL_SOCKET, SO_RCVBUF, &small, sizeof small);
-    sockaddr_in addr{};
-    addr.sin_family = AF_INET;
-    addr.sin_port = htons(static_cast<std::uint16_t>(d.port()));
-    addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    const int fd = connect_local(d.port(), 30, 4096);
+    if (fd < 0) continue;
     const std::string request = "GET " + path + " HTTP/1.1\r\nHost: x\r\n\r\n";
-    if (::connect(fd, reinterpret_cast<sockaddr*>(&addr), sizeof addr) == 0)
-      (void)::send(fd, request.data(), request.size(), MSG_NOSIGNAL);
+    (void)::send(fd, request.data(), request.size(), MSG_NOSIGNAL);
     sockets.push_back(fd);
   }
   std::this_thread::sleep_for(std::chrono::seconds(3));

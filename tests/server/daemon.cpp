@@ -208,19 +208,29 @@ std::string raw_exchange(int port, const std::string& request, double timeout) {
   return raw_exchange(port, std::vector<std::string>{request}, 0, timeout);
 }
 
-std::string raw_exchange(int port, const std::vector<std::string>& parts, double pause, double timeout) {
+int connect_local(int port, double timeout, int receive_buffer) {
   const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
-  if (fd < 0) throw std::runtime_error("socket() failed");
+  if (fd < 0) return -1;
   timeval tv{};
   tv.tv_sec = static_cast<long>(timeout);
   tv.tv_usec = static_cast<long>((timeout - static_cast<double>(tv.tv_sec)) * 1e6);
   ::setsockopt(fd, SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof tv);
+  if (receive_buffer > 0) ::setsockopt(fd, SOL_SOCKET, SO_RCVBUF, &receive_buffer, sizeof receive_buffer);
   sockaddr_in addr{};
   addr.sin_family = AF_INET;
   addr.sin_port = htons(static_cast<std::uint16_t>(port));
   addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  if (::connect(fd, reinterpret_cast<sockaddr*>(&addr), sizeof addr) != 0) {
+    ::close(fd);
+    return -1;
+  }
+  return fd;
+}
+
+std::string raw_exchange(int port, const std::vector<std::string>& parts, double pause, double timeout) {
+  const int fd = connect_local(port, timeout);
   std::string answer;
-  bool sent = ::connect(fd, reinterpret_cast<sockaddr*>(&addr), sizeof addr) == 0;
+  bool sent = fd >= 0;
   for (std::size_t i = 0; sent && i < parts.size(); ++i) {
     if (i > 0) std::this_thread::sleep_for(std::chrono::duration<double>(pause));
     sent = ::send(fd, parts[i].data(), parts[i].size(), MSG_NOSIGNAL) == static_cast<ssize_t>(parts[i].size());

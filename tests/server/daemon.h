@@ -82,6 +82,10 @@ SseStream read_events(int port, const std::string& path, const httplib::Headers&
 
 /// Sends `request` (raw bytes: a request line, headers, maybe a body) to 127.0.0.1:`port` and
 /// returns what the server answers until it closes or sends nothing for `timeout` seconds.
+/// A socket connected to the daemon on loopback `port`, its reads timing out after `timeout`
+/// seconds and its receive buffer `receive_buffer` bytes when not 0 (a client that reads slowly);
+/// -1 when it cannot connect.
+int connect_local(int port, double timeout, int receive_buffer = 0);
 std::string raw_exchange(int port, const std::string& request, double timeout);
 /// The same with the request sent in parts, `pause` seconds apart (each part its own segment).
 std::string raw_exchange(int port, const std::vector<std::string>& parts, double pause, double timeout);

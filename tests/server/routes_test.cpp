@@ -1457,17 +1457,8 @@ TEST_CASE("remeshd: a download under way finishes whole when its job is removed 
   REQUIRE(whole->body.size() > 2'000'000);
 
   // A client that reads the head and a little, then waits while the job is removed.
-  const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
+  const int fd = connect_local(d.port(), 10, 4096);
   REQUIRE(fd >= 0);
-  int small = 4096;
-  ::setsockopt(fd, SOL_SOCKET, SO_RCVBUF, &small, sizeof small);
-  timeval tv{10, 0};
-  ::setsockopt(fd, SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof tv);
-  sockaddr_in addr{};
-  addr.sin_family = AF_INET;
-  addr.sin_port = htons(static_cast<std::uint16_t>(d.port()));
-  addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  REQUIRE(::connect(fd, reinterpret_cast<sockaddr*>(&addr), sizeof addr) == 0);
   const std::string request = "GET " + path + " HTTP/1.1\r\nHost: x\r\nConnection: close\r\n\r\n";
   REQUIRE(::send(fd, request.data(), request.size(), MSG_NOSIGNAL) == static_cast<ssize_t>(request.size()));
   std::string answer;
@@ -1564,4 +1555,31 @@ TEST_CASE("remeshd: compressed uploads decode a bounded amount at once, the rest
   auto metrics = c.Get("/metrics");
   REQUIRE(metrics);
   CHECK(metrics->body.find("remeshd_busy_refusals_total{reason=\"upload_slots\"} 2") != std::string::npos);
+}
+
+TEST_CASE("remeshd: a client that closes its sending side after its request is answered", "[server]") {
+  // nc -N and shutdown(SHUT_WR): cpp-httplib 0.11.4 took the end of file for a client gone and
+  // wrote nothing, though it ran the request (QA: a POST made a job whose id its client never saw).
+  TempDir tmp;
+  Daemon d(tmp.path / "data", {"--workers", "1"});
+  auto half_closed = [&](const std::string& request) {
+    const int fd = connect_local(d.port(), 10);
+    REQUIRE(fd >= 0);
+    REQUIRE(::send(fd, request.data(), request.size(), MSG_NOSIGNAL) == static_cast<ssize_t>(request.size()));
+    ::shutdown(fd, SHUT_WR);
+    std::string answer;
+    char buffer[4096];
+    for (ssize_t n; (n = ::recv(fd, buffer, sizeof buffer, 0)) > 0;) answer.append(buffer, static_cast<std::size_t>(n));
+    ::close(fd);
+    return answer;
+  };
+  CHECK(status_codes(half_closed("GET /healthz HTTP/1.1\r\nHost: x\r\n\r\n")) == std::vector<std::string>{"200"});
+  const std::string mesh = sphere_obj(1);
+  const std::string answer = half_closed("POST /api/v1/jobs?emin=0.3&emax=0.5&iterations=2 HTTP/1.1\r\nHost: x\r\n"
+                                         "Content-Type: model/obj\r\nContent-Length: " +
+                                         std::to_string(mesh.size()) + "\r\n\r\n" + mesh);
+  REQUIRE(status_codes(answer) == std::vector<std::string>{"202"});
+  const std::string id = json::parse(answer.substr(answer.find("\r\n\r\n") + 4))["id"];
+  auto c = d.client();
+  CHECK(get_job(c, id)["id"] == id);
 }
