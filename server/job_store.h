@@ -60,7 +60,8 @@ class JobStore {
   /// Removes the job's result files (remeshed.*, dual.*), keeping its upload, state and statistics
   /// (a job cancelled after they were written; no error for files already gone).
   void remove_results(const std::string& id);
-  /// Removes the job's directory (no error if it is gone).
+  /// Removes the job's directory (no error if it is gone), renamed away first so that nothing
+  /// written for the job meanwhile brings it back.
   void remove(const std::string& id);
   /// Bytes used by the job's directory.
   std::uint64_t job_bytes(const std::string& id) const;

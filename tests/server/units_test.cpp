@@ -158,6 +158,52 @@ TEST_CASE("route patterns", "[server][routes]") {
   CHECK(route_pattern("/api/v1/openapi.yaml") == "/api/v1/openapi\\.yaml");
 }
 
+TEST_CASE("JobStore: a job removed while files are written for it stays removed", "[server][storage]") {
+  // A download converting a result while its job is deleted: remove_all alone stopped part-way when
+  // a file appeared in the directory, which stayed (with its state.json at times: the job came back
+  // at the next start; QA, 9 of 25 deletes during conversions).
+  fs::path root = temp_dir();
+  std::vector<std::string> ids;
+  {
+    JobStore store(root);
+    const std::string bytes(256 * 1024, 'x');
+    for (int round = 0; round < 20; ++round) {
+      remesh::api::JobRecord r;
+      r.id = remesh::api::new_job_id();
+      r.created_at = remesh::api::now_seconds();
+      r.format = "obj";
+      r.summary = nlohmann::json::object();
+      store.create(r, "v 0 0 0\n");
+      for (int i = 0; i < 40; ++i) store.write_file(r.id, "dual." + std::to_string(i) + ".ply", bytes);
+      ids.push_back(r.id);
+      std::atomic<bool> go{false};
+      std::thread writer([&] {
+        while (!go) std::this_thread::yield();
+        for (int i = 0; i < 200; ++i) {  // until the directory is gone (or, were it to stay, 50 MB)
+          try {
+            store.write_file(r.id, "input." + std::to_string(i) + ".gltf", bytes);
+          } catch (const std::exception&) {
+            return;
+          }
+        }
+      });
+      go = true;
+      std::this_thread::sleep_for(std::chrono::microseconds(200 * (round % 5)));
+      store.remove(r.id);
+      writer.join();
+      CHECK_FALSE(fs::exists(store.file_path(r.id, "")));
+    }
+  }
+  JobStore again(root);  // a restart
+  std::vector<std::string> problems;
+  CHECK(again.load_all(problems).empty());
+  CHECK(problems.empty());
+  std::size_t entries = 0;
+  for ([[maybe_unused]] const auto& entry : fs::directory_iterator(root / "jobs")) ++entries;
+  CHECK(entries == 0);  // what late writers left went at the start
+  fs::remove_all(root);
+}
+
 TEST_CASE("JobStore: atomic job directories, torn stats lines, bad ids", "[server][storage]") {
   fs::path root = temp_dir();
   {
