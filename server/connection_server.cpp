@@ -147,6 +147,29 @@ bool next_request(const ConnectionStream& strm, socket_t sock, const std::atomic
   }
 }
 
+/// Ends a connection without resetting it. A socket closed with bytes it has not read sends a reset,
+/// which makes the peer drop what it has not read yet of the answers already sent (QA: five
+/// pipelined downloads and a sixth request after them, on a connection that ends after five: the
+/// client got one or two of the five, then ECONNRESET). So the sending side is shut first (the
+/// answers, then the end), and what the client still sends is read and dropped until it closes
+/// too, for at most kLingerMs (RFC 9112 9.6).
+void close_gently(socket_t sock) {
+  constexpr long kLingerMs = 2000;
+  ::shutdown(sock, SHUT_WR);
+  const auto end = std::chrono::steady_clock::now() + std::chrono::milliseconds(kLingerMs);
+  char dropped[4096];
+  for (;;) {
+    const long left =
+        std::chrono::duration_cast<std::chrono::milliseconds>(end - std::chrono::steady_clock::now()).count();
+    if (left <= 0 || wait_for(sock, POLLIN, left) <= 0) break;
+    ssize_t n;
+    do n = ::recv(sock, dropped, sizeof dropped, 0);
+    while (n < 0 && errno == EINTR);
+    if (n <= 0) break;  // the client's end, or an error
+  }
+  ::close(sock);
+}
+
 }  // namespace
 
 void ConnectionServer::widen_backlog() {
@@ -165,8 +188,7 @@ bool ConnectionServer::process_and_close_socket(socket_t sock) {
     ok = process_request(strm, left == 1, closed, nullptr);
     if (!ok || closed) break;
   }
-  ::shutdown(sock, SHUT_RDWR);
-  ::close(sock);
+  close_gently(sock);
   return ok;
 }
 

@@ -13,6 +13,10 @@
 /// - **The accept backlog.** 0.11.4 listens with a backlog of 5, so a burst of connections (a page
 ///   opening several streams, many clients) waited for SYN retransmits (1 s or more).
 ///
+/// - **The end of a connection.** 0.11.4 closed it with what the client had sent past the last
+///   request unread, which resets it: the client lost the end of the answers already sent. Here
+///   the sending side is shut first, and the rest read and dropped (at most 2 s).
+///
 /// A connection still ends as in httplib: after keep_alive_max_count requests, when the client
 /// sends no request within the keep-alive timeout, when a request asks for it or fails, or when
 /// the server stops listening (checked every 50 ms while the connection waits, not only between
