@@ -71,6 +71,24 @@ std::string coded_in_two(const std::string& text, std::size_t part, int wbits, s
   return coded;
 }
 
+/// A finished job whose dual as LAMMPS is over 2 MB (more than loopback's socket buffers hold at
+/// first): its id, that download's path and its bytes.
+struct LargeResult {
+  std::string id, path, bytes;
+};
+LargeResult large_result(httplib::Client& c) {
+  LargeResult r;
+  r.id = submit(c, sphere_obj(4), "emin=0.02&emax=0.03");
+  REQUIRE(wait_final(c, r.id, 120)["state"] == "succeeded");
+  r.path = "/api/v1/jobs/" + r.id + "/result?mesh=dual&format=lammps";
+  auto whole = c.Get(r.path.c_str());
+  REQUIRE(whole);
+  REQUIRE(whole->status == 200);
+  REQUIRE(whole->body.size() > 2'000'000);
+  r.bytes = std::move(whole->body);
+  return r;
+}
+
 /// The text of api/openapi.yaml in the source tree.
 std::string openapi_yaml() {
   std::ifstream in(REMESHD_OPENAPI);
@@ -1448,13 +1466,8 @@ TEST_CASE("remeshd: a download under way finishes whole when its job is removed 
   TempDir tmp;
   Daemon d(tmp.path / "data", {"--workers", "1"});
   auto c = d.client();
-  const std::string id = submit(c, sphere_obj(4), "emin=0.02&emax=0.03");
-  REQUIRE(wait_final(c, id, 120)["state"] == "succeeded");
-  const std::string path = "/api/v1/jobs/" + id + "/result?mesh=dual&format=lammps";
-  auto whole = c.Get(path.c_str());
-  REQUIRE(whole);
-  REQUIRE(whole->status == 200);
-  REQUIRE(whole->body.size() > 2'000'000);
+  const LargeResult large = large_result(c);
+  const std::string &id = large.id, &path = large.path;
 
   // A client that reads the head and a little, then waits while the job is removed.
   const int fd = connect_local(d.port(), 10, 4096);
@@ -1477,7 +1490,7 @@ TEST_CASE("remeshd: a download under way finishes whole when its job is removed 
   const std::size_t head_end = answer.find("\r\n\r\n");
   REQUIRE(head_end != std::string::npos);
   CHECK(answer.rfind("HTTP/1.1 200", 0) == 0);
-  CHECK(answer.substr(head_end + 4) == whole->body);
+  CHECK(answer.substr(head_end + 4) == large.bytes);
 }
 
 TEST_CASE("remeshd: a body refused before it is read whole ends the connection", "[server]") {
@@ -1591,17 +1604,13 @@ TEST_CASE("remeshd: a connection that ends with requests unread still delivers i
   TempDir tmp;
   Daemon d(tmp.path / "data", {"--workers", "1"});
   auto c = d.client();
-  const std::string id = submit(c, sphere_obj(4), "emin=0.02&emax=0.03");
-  REQUIRE(wait_final(c, id, 120)["state"] == "succeeded");
-  const std::string path = "/api/v1/jobs/" + id + "/result?mesh=dual&format=lammps";
-  auto whole = c.Get(path.c_str());
-  REQUIRE(whole);
-  REQUIRE(whole->body.size() > 2'000'000);
+  const LargeResult large = large_result(c);
+  const std::string& path = large.path;
   const std::string get = "GET " + path + " HTTP/1.1\r\nHost: x\r\n\r\n";
   std::string five;
   for (int i = 0; i < 5; ++i) five += get;
   const std::string answer = raw_exchange(d.port(), {five, get}, 0.05, 30);
   CHECK(status_codes(answer) == std::vector<std::string>(5, "200"));
-  CHECK(answer.size() > 5 * whole->body.size());
-  CHECK(answer.substr(answer.size() - whole->body.size()) == whole->body);
+  CHECK(answer.size() > 5 * large.bytes.size());
+  CHECK(answer.substr(answer.size() - large.bytes.size()) == large.bytes);
 }
