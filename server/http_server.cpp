@@ -502,7 +502,8 @@ void HttpServer::Impl::setup() {
     // Answered before its body is read: the connection ends with the answer, or the body would be
     // read as the next request (connection_server.h keeps what was read past the head; review: a
     // 401 to a POST whose body was a request ran that request).
-    if (answer == httplib::Server::HandlerResponse::Handled && has_body(req)) res.set_header("Connection", "close");
+    if (answer == httplib::Server::HandlerResponse::Handled && has_body(req) && !res.has_header("Connection"))
+      res.set_header("Connection", "close");
     return answer;
   });
   server.set_post_routing_handler([this](const httplib::Request& req, httplib::Response& res) {
@@ -1014,7 +1015,7 @@ void HttpServer::Impl::post_job(const httplib::Request& req, httplib::Response& 
   }
   if (!ok) {
     // The rest of the body is unread (or its framing broken): it must not be read as a request.
-    res.set_header("Connection", "close");
+    if (!res.has_header("Connection")) res.set_header("Connection", "close");
     std::string type = req.get_header_value("Content-Type");
     auto b = type.find("boundary=");
     if (req.is_multipart_form_data() && b != std::string::npos && type.find(';', b) != std::string::npos)
