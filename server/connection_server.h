@@ -1,6 +1,6 @@
 #pragma once
 /// \file connection_server.h
-/// httplib::Server with its connections' loop of our own, for two faults of cpp-httplib 0.11.4:
+/// httplib::Server with its connections' loop of our own, for faults of cpp-httplib 0.11.4:
 ///
 /// - **Pipelined requests.** 0.11.4 reads a connection through a stream made anew for each request,
 ///   whose 4 KiB read-ahead is dropped with it. Whatever a client sent past one request (the next
@@ -12,10 +12,12 @@
 ///   answered in order).
 /// - **The accept backlog.** 0.11.4 listens with a backlog of 5, so a burst of connections (a page
 ///   opening several streams, many clients) waited for SYN retransmits (1 s or more).
-///
 /// - **The end of a connection.** 0.11.4 closed it with what the client had sent past the last
 ///   request unread, which resets it: the client lost the end of the answers already sent. Here
-///   the sending side is shut first, and the rest read and dropped (at most 2 s).
+///   the sending side is shut first, and what the client still sends is read and dropped (at most
+///   2 s; a connection with nothing to read closes at once).
+/// - **Half-closed clients.** 0.11.4 took a client that closed its sending side after its request
+///   (nc -N) for one gone and wrote it nothing; here it is answered (ConnectionStream::is_writable).
 ///
 /// A connection still ends as in httplib: after keep_alive_max_count requests, when the client
 /// sends no request within the keep-alive timeout, when a request asks for it or fails, or when
