@@ -20,16 +20,19 @@ struct BodyDecoder::Impl {
   bool feed_zlib(const char* data, std::size_t n, const Sink& sink) {
     z.next_in = reinterpret_cast<Bytef*>(const_cast<char*>(data));
     z.avail_in = static_cast<uInt>(n);
-    while (z.avail_in > 0) {
-      if (ended) {
+    bool full = false;  // the last call filled the output: inflate may hold more back
+    for (;;) {
+      if (ended && z.avail_in > 0) {
         // Bytes after the end: another gzip member (RFC 1952 2.2), or zeros padding it (as GNU gzip
         // takes them: tape blocks); else not the coding.
         if (kind != Kind::Gzip) return false;
         while (z.avail_in > 0 && *z.next_in == 0) ++z.next_in, --z.avail_in;
-        if (z.avail_in == 0) break;
-        if (inflateReset(&z) != Z_OK) return false;
-        ended = false;
+        if (z.avail_in > 0) {
+          if (inflateReset(&z) != Z_OK) return false;
+          ended = false;
+        }
       }
+      if (ended || (z.avail_in == 0 && !full)) return true;
       z.next_out = out.data();
       z.avail_out = static_cast<uInt>(out.size());
       const uInt before = z.avail_in;
@@ -38,20 +41,10 @@ struct BodyDecoder::Impl {
       const std::size_t made = out.size() - z.avail_out;
       if (made > 0 && !sink(reinterpret_cast<const char*>(out.data()), made)) return false;
       ended = r == Z_STREAM_END;
-      if (!ended && made == 0 && z.avail_in == before) return false;  // no progress: cannot happen
+      full = z.avail_out == 0;
+      // No progress: all input taken and nothing held back (more input needed), else never.
+      if (!ended && made == 0 && z.avail_in == before) return z.avail_in == 0;
     }
-    // The input is consumed; what inflate holds back past a full output buffer comes out here.
-    while (!ended) {
-      z.next_out = out.data();
-      z.avail_out = static_cast<uInt>(out.size());
-      const int r = inflate(&z, Z_NO_FLUSH);
-      if (r != Z_OK && r != Z_STREAM_END && r != Z_BUF_ERROR) return false;
-      const std::size_t made = out.size() - z.avail_out;
-      if (made > 0 && !sink(reinterpret_cast<const char*>(out.data()), made)) return false;
-      ended = r == Z_STREAM_END;
-      if (made == 0) break;
-    }
-    return true;
   }
 
   bool feed_brotli(const char* data, std::size_t n, const Sink& sink) {

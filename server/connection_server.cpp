@@ -30,6 +30,11 @@ int wait_for(socket_t sock, short events, long ms) {
   return r;
 }
 
+/// Milliseconds from now until `end` (negative once past).
+long ms_until(std::chrono::steady_clock::time_point end) {
+  return std::chrono::duration_cast<std::chrono::milliseconds>(end - std::chrono::steady_clock::now()).count();
+}
+
 long milliseconds(time_t sec, time_t usec) { return static_cast<long>(sec) * 1000 + static_cast<long>(usec) / 1000; }
 
 /// False once the peer has closed (a read would return end of file) or the socket failed; true
@@ -139,8 +144,7 @@ bool next_request(const ConnectionStream& strm, socket_t sock, const std::atomic
   if (strm.buffered()) return true;
   const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(timeout_sec);
   for (;;) {
-    const long left =
-        std::chrono::duration_cast<std::chrono::milliseconds>(end - std::chrono::steady_clock::now()).count();
+    const long left = ms_until(end);
     const int r = wait_for(sock, POLLIN, std::min(50L, std::max(0L, left)));
     if (r != 0) return r > 0;
     if (listening == INVALID_SOCKET || left <= 0) return false;
@@ -164,8 +168,7 @@ void close_gently(socket_t sock) {
   const auto end = std::chrono::steady_clock::now() + std::chrono::milliseconds(kLingerMs);
   char dropped[4096];
   for (;;) {
-    const long left =
-        std::chrono::duration_cast<std::chrono::milliseconds>(end - std::chrono::steady_clock::now()).count();
+    const long left = ms_until(end);
     if (left <= 0 || wait_for(sock, POLLIN, left) <= 0) break;
     ssize_t n;
     do n = ::recv(sock, dropped, sizeof dropped, 0);

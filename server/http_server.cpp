@@ -434,7 +434,9 @@ struct HttpServer::Impl {
   }
 
   void setup();
+  /// pre_route_checks, and a request it answers with its body unread ends its connection.
   httplib::Server::HandlerResponse pre_route(const httplib::Request& req, httplib::Response& res);
+  httplib::Server::HandlerResponse pre_route_checks(const httplib::Request& req, httplib::Response& res);
   httplib::Server::HandlerResponse unparsed_range(const httplib::Request& req, httplib::Response& res);
   void cors_headers(httplib::Response& res) const;
   bool authorized(const httplib::Request& req) const;
@@ -497,15 +499,8 @@ void HttpServer::Impl::setup() {
   for (const RouteSpec& r : kRoutes)
     route_labels.emplace_back(std::regex(route_pattern(r.path)), r.path);
 
-  server.set_pre_routing_handler([this](const httplib::Request& req, httplib::Response& res) {
-    const auto answer = pre_route(req, res);
-    // Answered before its body is read: the connection ends with the answer, or the body would be
-    // read as the next request (connection_server.h keeps what was read past the head; review: a
-    // 401 to a POST whose body was a request ran that request).
-    if (answer == httplib::Server::HandlerResponse::Handled && has_body(req) && !res.has_header("Connection"))
-      res.set_header("Connection", "close");
-    return answer;
-  });
+  server.set_pre_routing_handler(
+      [this](const httplib::Request& req, httplib::Response& res) { return pre_route(req, res); });
   server.set_post_routing_handler([this](const httplib::Request& req, httplib::Response& res) {
     cors_headers(res);
     res.set_header("X-Content-Type-Options", "nosniff");
@@ -645,6 +640,17 @@ void HttpServer::Impl::setup() {
 /// range out of httplib's hands.
 httplib::Server::HandlerResponse HttpServer::Impl::pre_route(const httplib::Request& req,
                                                              httplib::Response& res) {
+  const auto answer = pre_route_checks(req, res);
+  // Answered before its body is read: the connection ends with the answer, or the body would be
+  // read as the next request (connection_server.h keeps what was read past the head; review: a
+  // 401 to a POST whose body was a request ran that request).
+  if (answer == httplib::Server::HandlerResponse::Handled && has_body(req) && !res.has_header("Connection"))
+    res.set_header("Connection", "close");
+  return answer;
+}
+
+httplib::Server::HandlerResponse HttpServer::Impl::pre_route_checks(const httplib::Request& req,
+                                                                    httplib::Response& res) {
   t_request_start = std::chrono::steady_clock::now();
   t_pre_routed = true;
   t_streamed_bytes = 0;
@@ -723,7 +729,6 @@ httplib::Server::HandlerResponse HttpServer::Impl::pre_route(const httplib::Requ
   // (Range given twice is ignored, as any range not of one part: the whole answer.)
   for (const char* name : {"Authorization", "If-Range", "Last-Event-ID", "Content-Type"}) {
     if (const std::size_t n = req.get_header_value_count(name); n > 1) {
-      if (has_body(req)) res.set_header("Connection", "close");  // its body is not read
       send_problem(res, 400, std::string("malformed request: the header ") + name + " is given " + std::to_string(n) +
                                  " times; give it once");
       return httplib::Server::HandlerResponse::Handled;
@@ -741,7 +746,6 @@ httplib::Server::HandlerResponse HttpServer::Impl::pre_route(const httplib::Requ
     const std::string list = req.get_header_value("Content-Encoding");
     const bool known = codings.size() == 1 && (codings[0] == "gzip" || codings[0] == "deflate" || codings[0] == "br");
     if (codings.size() > 1 || (codings.size() == 1 && !known)) {
-      res.set_header("Connection", "close");  // its body is not read
       send_problem(res, 415, "Content-Encoding '" + list.substr(0, 40) +
                                  "' is not supported: send the body as it is, or coded once with one of gzip, "
                                  "deflate, br");
@@ -785,7 +789,6 @@ httplib::Server::HandlerResponse HttpServer::Impl::pre_route(const httplib::Requ
   }
   if (req.path.rfind("/api/", 0) == 0) {
     if (auto errors = repeated_query_keys(req); !errors.empty()) {
-      if (has_body(req)) res.set_header("Connection", "close");  // its body is not read
       send_problem(res, 422, "invalid query: see errors", errors);
       return httplib::Server::HandlerResponse::Handled;
     }
