@@ -106,7 +106,7 @@ class CreaseLines {
 ///   crease;
 /// - an edge with one end on a crease (not along it) collapses onto that end; one with both ends on
 ///   creases (not along one) is not collapsed, nor one along a crease between two corners.
-/// Measured: Params::keep_creases (params.h) and bench/README.md.
+/// Measured: Params::keep_creases (params.h) and bench/HISTORY.md.
 class CreaseGuard {
  public:
   /// The crease between an edge's ends may be this much longer than the edge (a chord over an arc

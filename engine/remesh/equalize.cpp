@@ -531,7 +531,7 @@ void Run::stellar_step(IterationStats& counters) {
   // refined: vertices up to 0.62 units off the surface in every iteration from the 14th, 0.33
   // in the returned mesh; after this, 0.06 in the iterations). Before the flips, which see the
   // projected points: after them, the Hausdorff distances came out between and cheese's
-  // simplification crossed more. Measured: bench/README.md, "Vertices kept on the surface".
+  // simplification crossed more. Measured: bench/HISTORY.md, "Vertices kept on the surface".
   project_vertices(mesh_, placed, *reference_, threads, &caches_);
   collect_garbage(mesh_);
   renumbered_since_ += stellar.splits + stellar.collapses;
