@@ -17,8 +17,11 @@
 #include <string>
 
 #include "io/mesh_io.h"
+#include "job_manager.h"
 #include "job_runner.h"
 #include "job_store.h"
+#include "log.h"
+#include "metrics.h"
 #include "open_file.h"
 #include "options.h"
 #include "routes.h"
@@ -201,6 +204,43 @@ TEST_CASE("JobStore: a job removed while files are written for it stays removed"
   std::size_t entries = 0;
   for ([[maybe_unused]] const auto& entry : fs::directory_iterator(root / "jobs")) ++entries;
   CHECK(entries == 0);  // what late writers left went at the start
+  fs::remove_all(root);
+}
+
+TEST_CASE("JobManager: a job submitted during shutdown is refused and stores nothing; one accepted before is queued again",
+          "[server][restart]") {
+  fs::path root = temp_dir();
+  Logger log;
+  Metrics metrics;
+  auto job = [] {
+    remesh::api::JobRecord r;
+    r.id = remesh::api::new_job_id();
+    r.created_at = remesh::api::now_seconds();
+    r.format = "obj";
+    r.summary = nlohmann::json::object();
+    return r;
+  };
+  const remesh::api::JobRecord before = job(), during = job();
+  {
+    // Not started: no worker takes the accepted job, which stays queued.
+    JobStore store(root);
+    JobManager manager(ManagerConfig{}, store, log, metrics);
+    CHECK(manager.submit(before, "v 0 0 0\n") == JobManager::Submit::Accepted);
+    manager.shutdown();
+    CHECK(manager.submit(during, "v 0 0 0\n") == JobManager::Submit::ShuttingDown);
+    CHECK_FALSE(manager.record(during.id).has_value());
+    CHECK_FALSE(fs::exists(store.file_path(during.id, "")));
+    const auto kept = manager.record(before.id);
+    REQUIRE(kept.has_value());
+    CHECK(kept->state == remesh::api::JobState::Queued);
+  }
+  // What the next start finds on disk: the job accepted before, queued, and nothing of the other.
+  std::vector<std::string> problems;
+  const std::vector<JobStore::Loaded> stored = JobStore(root).load_all(problems);
+  CHECK(problems.empty());
+  REQUIRE(stored.size() == 1);
+  CHECK(stored[0].record.id == before.id);
+  CHECK(stored[0].record.state == remesh::api::JobState::Queued);
   fs::remove_all(root);
 }
 
