@@ -207,7 +207,7 @@ TEST_CASE("JobStore: a job removed while files are written for it stays removed"
   fs::remove_all(root);
 }
 
-TEST_CASE("JobManager: a job submitted during shutdown is refused and stores nothing; one accepted before is queued again",
+TEST_CASE("JobManager: a job submitted during shutdown is refused and stores nothing and one accepted before stays queued",
           "[server][restart]") {
   fs::path root = temp_dir();
   Logger log;
