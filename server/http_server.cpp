@@ -1382,18 +1382,13 @@ void HttpServer::Impl::static_files(const httplib::Request& req, httplib::Respon
     send_problem(res, 404, "no such route: " + req.method + " " + req.path);
     return;
   }
-  auto file = static_file(web_root, req.path);
-  if (!file) {
-    if (req.path == "/" || req.path == "/index.html") {
-      send_ranged(req, res, missing_web_root_page(web_root), "text/html; charset=utf-8", true);
-      return;
-    }
-    send_problem(res, 404, "no such file: " + req.path.substr(0, 200));
-    return;
-  }
-  auto opened = OpenFile::open(*file);
+  const auto file = static_file(web_root, req.path);
+  auto opened = file ? OpenFile::open(*file) : nullptr;  // null too when the file went meanwhile
   if (!opened) {
-    send_problem(res, 404, "no such file: " + req.path.substr(0, 200));
+    if (!file && (req.path == "/" || req.path == "/index.html"))
+      send_ranged(req, res, missing_web_root_page(web_root), "text/html; charset=utf-8", true);
+    else
+      send_problem(res, 404, "no such file: " + req.path.substr(0, 200));
     return;
   }
   res.set_header("Cache-Control", "no-cache");
